@@ -1,0 +1,25 @@
+# gilab_add_technique(<id> SOURCES <files...> [SHADERS <files...>])
+#
+# A technique is techniques/<id>/ plus shaders/<id>/ and this one line in the top-level table.
+# It builds as an OBJECT library so the GILAB_REGISTER_TECHNIQUE object in its .cpp is always
+# linked into gilab and the tests (a static library would let the linker drop it).
+function(gilab_add_technique id)
+    cmake_parse_arguments(ARG "" "" "SOURCES;SHADERS" ${ARGN})
+    set(target gilab_technique_${id})
+    add_library(${target} OBJECT ${ARG_SOURCES})
+    target_link_libraries(${target} PUBLIC gilab_core)
+    target_compile_options(${target} PRIVATE ${GILAB_WARNINGS})
+    if(ARG_SHADERS)
+        gilab_add_shaders(${target} SOURCES ${ARG_SHADERS})
+    endif()
+    set_property(GLOBAL APPEND PROPERTY GILAB_TECHNIQUE_TARGETS ${target})
+endfunction()
+
+# Links every self-registering OBJECT library (techniques, embedded shaders) into <target>.
+function(gilab_link_plugins target)
+    get_property(techniques GLOBAL PROPERTY GILAB_TECHNIQUE_TARGETS)
+    foreach(t ${techniques})
+        target_sources(${target} PRIVATE $<TARGET_OBJECTS:${t}>)
+        target_link_libraries(${target} PRIVATE ${t})
+    endforeach()
+endfunction()

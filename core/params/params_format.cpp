@@ -1,0 +1,141 @@
+// Spec-table helpers, help text and "key=value" splitting.
+#include <algorithm>
+#include <cmath>
+
+#include "core/params/params.h"
+#include "core/util/error.h"
+#include "core/util/strings.h"
+
+namespace gilab {
+
+ParamSpec boolParam(std::string name, bool def, std::string help, ParamStage stage) {
+    ParamSpec spec;
+    spec.name = std::move(name);
+    spec.type = ParamType::Bool;
+    spec.defaultValue = def ? "true" : "false";
+    spec.help = std::move(help);
+    spec.stage = stage;
+    return spec;
+}
+
+ParamSpec intParam(std::string name, int def, double minValue, double maxValue, std::string unit,
+                   std::string help, ParamStage stage) {
+    ParamSpec spec;
+    spec.name = std::move(name);
+    spec.type = ParamType::Int;
+    spec.defaultValue = std::to_string(def);
+    spec.minValue = minValue;
+    spec.maxValue = maxValue;
+    spec.unit = std::move(unit);
+    spec.help = std::move(help);
+    spec.stage = stage;
+    return spec;
+}
+
+ParamSpec floatParam(std::string name, double def, double minValue, double maxValue,
+                     std::string unit, std::string help, ParamStage stage) {
+    ParamSpec spec;
+    spec.name = std::move(name);
+    spec.type = ParamType::Float;
+    spec.defaultValue = formatShortest(def);
+    spec.minValue = minValue;
+    spec.maxValue = maxValue;
+    spec.unit = std::move(unit);
+    spec.help = std::move(help);
+    spec.stage = stage;
+    return spec;
+}
+
+ParamSpec enumParam(std::string name, std::string def, std::vector<std::string> choices,
+                    std::string help, ParamStage stage) {
+    ParamSpec spec;
+    spec.name = std::move(name);
+    spec.type = ParamType::Enum;
+    spec.defaultValue = std::move(def);
+    spec.choices = std::move(choices);
+    spec.help = std::move(help);
+    spec.stage = stage;
+    return spec;
+}
+
+const char* paramTypeName(ParamType type) {
+    switch (type) {
+        case ParamType::Bool:
+            return "bool";
+        case ParamType::Int:
+            return "int";
+        case ParamType::Float:
+            return "float";
+        case ParamType::Enum:
+            return "enum";
+    }
+    return "?";
+}
+
+const char* paramStageName(ParamStage stage) {
+    return stage == ParamStage::Rebuild ? "rebuild" : "per-frame";
+}
+
+std::string describeParamRange(const ParamSpec& spec) {
+    switch (spec.type) {
+        case ParamType::Bool:
+            return "true|false";
+        case ParamType::Enum:
+            return joinStrings(spec.choices, "|");
+        case ParamType::Int:
+        case ParamType::Float:
+            break;
+    }
+    const bool hasMin = std::isfinite(spec.minValue);
+    const bool hasMax = std::isfinite(spec.maxValue);
+    // Built by appending: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string&&.
+    std::string out;
+    if (hasMin && hasMax) {
+        out.append("[").append(formatShortest(spec.minValue)).append(", ");
+        out.append(formatShortest(spec.maxValue)).append("]");
+    } else if (hasMin) {
+        out.append(">= ").append(formatShortest(spec.minValue));
+    } else if (hasMax) {
+        out.append("<= ").append(formatShortest(spec.maxValue));
+    } else {
+        out = "any";
+    }
+    return out;
+}
+
+std::string formatParamHelp(const std::vector<ParamSpec>& specs) {
+    std::vector<std::vector<std::string>> rows;
+    rows.push_back({"name", "type", "default", "range", "unit", "help", "stage"});
+    for (const ParamSpec& spec : specs) {
+        rows.push_back({spec.name, paramTypeName(spec.type), spec.defaultValue,
+                        describeParamRange(spec), spec.unit, spec.help,
+                        paramStageName(spec.stage)});
+    }
+    std::vector<size_t> widths(rows[0].size(), 0);
+    for (const auto& row : rows) {
+        for (size_t c = 0; c < row.size(); ++c)
+            widths[c] = std::max(widths[c], row[c].size());
+    }
+    std::string out;
+    for (const auto& row : rows) {
+        std::string line;
+        for (size_t c = 0; c < row.size(); ++c) {
+            line += row[c];
+            if (c + 1 < row.size()) line += std::string(widths[c] - row[c].size() + 2, ' ');
+        }
+        out += trimString(line) + "\n";
+    }
+    return out;
+}
+
+std::pair<std::string, std::string> splitAssignment(const std::string& text) {
+    const size_t eq = text.find('=');
+    if (eq == std::string::npos) throw Error("expected key=value, got '" + text + "'");
+    std::string key = trimString(std::string_view(text).substr(0, eq));
+    std::string value = trimString(std::string_view(text).substr(eq + 1));
+    if (key.empty()) throw Error("missing key before '=' in '" + text + "'");
+    if (value.empty()) throw Error("missing value after '=' in '" + text + "'");
+    return {key, value};
+}
+
+}  // namespace gilab

@@ -1,0 +1,332 @@
+#include "core/passes/shadow_maps.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "core/gpu/gpu_scene.h"
+#include "core/util/error.h"
+#include "core/vk/context.h"
+#include "core/vk/rendering.h"
+
+namespace gilab {
+namespace {
+
+constexpr float kNoOccluder = 3.0e38f;      // cleared distance: everything is lit
+constexpr float kSpotMarginRad = 0.0872665f;  // 5 deg added to the spot map's fov
+constexpr float kMaxSpotFovRad = 2.9670597f;  // 170 deg
+constexpr float kCubeSpotOuterRad = 1.4835299f;  // outer cones above 85 deg use a cube
+
+/** Vulkan cube face axes (spec "Cube Map Face Selection"): s, t and the major axis. */
+struct CubeFace {
+    glm::vec3 s, t, m;
+};
+constexpr CubeFace kCubeFaces[6] = {
+    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
+    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
+    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},   {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
+};
+
+/**
+ * Cube face f seen from `eye`: clip = (s.q, t.q, near, m.q) with q = p - eye, so the framebuffer
+ * (x, y) / size is exactly the face's (s, t) and depth = near / (m.q) is reversed-Z with an
+ * infinite far plane.
+ */
+glm::mat4 cubeFaceViewProj(const glm::vec3& eye, int face, float nearZ) {
+    const CubeFace& f = kCubeFaces[face];
+    glm::mat4 m(0.0f);
+    for (int i = 0; i < 3; ++i) {
+        m[i][0] = f.s[i];
+        m[i][1] = f.t[i];
+        m[i][3] = f.m[i];
+    }
+    m[3][0] = -glm::dot(f.s, eye);
+    m[3][1] = -glm::dot(f.t, eye);
+    m[3][2] = nearZ;
+    m[3][3] = -glm::dot(f.m, eye);
+    return m;
+}
+
+glm::vec3 upFor(const glm::vec3& dir) {
+    return std::abs(dir.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
+}
+
+/** Perspective with Vulkan y-down, reversed-Z and an infinite far plane. */
+glm::mat4 spotViewProj(const glm::vec3& eye, const glm::vec3& dir, float fov, float nearZ) {
+    const float f = 1.0f / std::tan(0.5f * fov);
+    glm::mat4 p(0.0f);
+    p[0][0] = f;
+    p[1][1] = -f;
+    p[2][3] = -1.0f;  // clip.w = -z_view
+    p[3][2] = nearZ;  // clip.z = near  ->  depth = near / distance
+    return p * glm::lookAtRH(eye, eye + dir, upFor(dir));
+}
+
+/** Orthographic over the square [-r, r]^2 with y down; depth = 1 - distance / (2r). */
+glm::mat4 orthoViewProj(const glm::vec3& origin, const glm::vec3& dir, float r) {
+    glm::mat4 p(0.0f);
+    p[0][0] = 1.0f / r;
+    p[1][1] = -1.0f / r;
+    p[2][2] = 1.0f / (2.0f * r);  // z_view = -distance
+    p[3][2] = 1.0f;
+    p[3][3] = 1.0f;
+    return p * glm::lookAtRH(origin, origin + dir, upFor(dir));
+}
+
+vk::Image makeDistanceImage(vk::Context& ctx, vk::ImageKind kind, uint32_t size, uint32_t layers,
+                            const char* name) {
+    vk::ImageDesc desc;
+    desc.kind = kind;
+    desc.format = ShadowMaps::kDistanceFormat;
+    desc.width = size;
+    desc.height = size;
+    desc.layers = layers;
+    desc.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    desc.name = std::string("shared/shadow.") + name;
+    return vk::Image(ctx, desc);
+}
+
+}  // namespace
+
+ShadowMaps::ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettings& settings,
+                       uint32_t areaLightSamples)
+    : m_ctx(ctx), m_scene(scene), m_settings(settings) {
+    if (settings.resolution == 0 || settings.areaResolution == 0) {
+        throw Error("ShadowSettings: resolution and areaResolution must be non-zero");
+    }
+    if (settings.pcfRadius < 0) throw Error("ShadowSettings: pcfRadius must be >= 0");
+    buildLightTable(scene, areaLightSamples);
+    createImages();
+
+    vk::SamplerDesc sampler;
+    sampler.filter = VK_FILTER_NEAREST;
+    sampler.mipmap = VK_SAMPLER_MIPMAP_MODE_NEAREST;
+    sampler.name = "shared/shadow.sampler";
+    m_sampler = vk::Sampler(ctx, sampler);
+
+    m_layout = vk::PipelineLayout(ctx, {scene.layout().handle()}, sizeof(Job::Push));
+    vk::GraphicsPipelineDesc desc;
+    desc.vertexShader = "common/shadow.vert";
+    desc.fragmentShader = "common/shadow.frag";
+    desc.sceneVertexInput = false;
+    desc.colorFormats = {kDistanceFormat};
+    desc.depthFormat = kDepthFormat;
+    desc.depthCompare = VK_COMPARE_OP_GREATER;  // reversed-Z
+    desc.cull = VK_CULL_MODE_NONE;              // thin walls and one-sided quads must cast
+    desc.name = "shared/shadow_maps";
+    m_pipeline = vk::GraphicsPipeline(ctx, desc, m_layout);
+}
+
+void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLightSamples) {
+    const Scene& scene = gpuScene.scene();
+    const bool shadows = m_settings.enabled;
+    const Bounds& b = scene.caps.bounds;
+    const glm::vec3 center = b.valid() ? b.center() : glm::vec3(0.0f);
+    const float radius = b.valid() ? std::max(0.5f * glm::length(b.extent()), 1e-3f) : 1.0f;
+    const float nearZ = 1e-3f * radius;
+    const float res = float(m_settings.resolution);
+    const glm::vec4 bias(m_settings.constantBias, m_settings.slopeBias, m_settings.normalOffset,
+                         float(m_settings.pcfRadius));
+
+    auto addCube = [&](PassLight& light, ShadowKind kind, uint32_t& counter, const Job::Push& base,
+                       float texelFactor) {
+        light.shadow = glm::vec4(float(kind), float(counter), texelFactor, 0.0f);
+        for (int face = 0; face < 6; ++face) {
+            Job job{kind, counter * 6 + uint32_t(face), base};
+            job.push.viewProj = cubeFaceViewProj(glm::vec3(light.positionType), face, nearZ);
+            job.push.origin = glm::vec4(glm::vec3(light.positionType), 0.0f);
+            m_jobs.push_back(job);
+        }
+        ++counter;
+    };
+
+    bool wideSpot = false;
+    for (const Light& l : scene.lights) {
+        PassLight light;
+        light.positionType = glm::vec4(l.position, 0.0f);
+        light.direction = glm::vec4(glm::normalize(l.direction), 0.0f);
+        light.intensity = glm::vec4(l.intensity, 0.0f);
+        light.cone = glm::vec4(std::cos(l.innerConeRad), std::cos(l.outerConeRad), 0.0f, 0.0f);
+        light.bias = bias;
+        const glm::vec3 dir(light.direction);
+        if (l.type == LightType::Point) {
+            light.positionType.w = float(kPassLightPoint);
+            if (shadows) addCube(light, kShadowCube, m_cubeCount, Job::Push{}, 2.0f / res);
+        } else if (l.type == LightType::Spot) {
+            light.positionType.w = float(kPassLightSpot);
+            if (shadows && l.outerConeRad > kCubeSpotOuterRad) {
+                wideSpot = true;
+                addCube(light, kShadowCube, m_cubeCount, Job::Push{}, 2.0f / res);
+            } else if (shadows) {
+                float fov = std::min(2.0f * l.outerConeRad + kSpotMarginRad, kMaxSpotFovRad);
+                light.viewProj = spotViewProj(l.position, dir, fov, nearZ);
+                light.shadow = glm::vec4(float(kShadowMap2D), float(m_layers2D),
+                                         2.0f * std::tan(0.5f * fov) / res, 0.0f);
+                Job job{kShadowMap2D, m_layers2D++, {}};
+                job.push.viewProj = light.viewProj;
+                job.push.origin = glm::vec4(l.position, 0.0f);
+                m_jobs.push_back(job);
+            }
+        } else {
+            light.positionType.w = float(kPassLightDirectional);
+            if (shadows) {
+                const float r = 1.02f * radius + 1e-4f;
+                const glm::vec3 origin = center - dir * r;
+                light.origin = glm::vec4(origin, 1.0f);
+                light.viewProj = orthoViewProj(origin, dir, r);
+                light.shadow = glm::vec4(float(kShadowMap2D), float(m_layers2D), 2.0f * r / res,
+                                         1.0f);
+                Job job{kShadowMap2D, m_layers2D++, {}};
+                job.push.viewProj = light.viewProj;
+                job.push.origin = glm::vec4(origin, 1.0f);
+                job.push.direction = glm::vec4(dir, 0.0f);
+                m_jobs.push_back(job);
+            }
+        }
+        m_lights.push_back(light);
+    }
+    m_sceneLightCount = uint32_t(m_lights.size());
+
+    // Emitter samples: cosine-lobe point lights with their own cubes
+    m_samples = buildEmitterSamples(scene, areaLightSamples);
+    const float areaRes = float(m_settings.areaResolution);
+    for (const EmitterSample& s : m_samples) {
+        PassLight light;
+        light.positionType = glm::vec4(s.position, float(kPassLightEmitterSample));
+        light.direction = glm::vec4(s.normal, s.twoSided ? 1.0f : 0.0f);
+        light.intensity = glm::vec4(s.intensity, 0.0f);
+        light.bias = bias;
+        if (shadows) {
+            Job::Push skip;
+            skip.skipPlane = glm::vec4(s.normal, glm::dot(s.normal, s.position));
+            skip.params.x = 1e-4f * radius;
+            addCube(light, kShadowAreaCube, m_areaCubeCount, skip, 2.0f / areaRes);
+        }
+        m_lights.push_back(light);
+    }
+
+    // Skip lines for what the scene lacks
+    const bool hasEmitters = countEmitterTriangles(scene) > 0;
+    if (areaLightSamples == 0) {
+        m_skipped.push_back("area_lights: areaLightSamples = 0 (emitters do not light the scene)");
+    } else if (!hasEmitters) {
+        m_skipped.push_back("area_lights: scene has no emissive triangles");
+    }
+    if (!shadows) {
+        m_skipped.push_back("shadow_maps: shadows disabled (visibility = 1)");
+    } else {
+        if (m_layers2D == 0) {
+            m_skipped.push_back("shadow.2d: scene has no spot or directional lights");
+        }
+        if (m_cubeCount == 0) {
+            m_skipped.push_back("shadow.cube: scene has no point lights (or spots wider than "
+                                "170 deg)");
+        }
+        if (m_areaCubeCount == 0) {
+            m_skipped.push_back("shadow.area_cube: no emitter samples");
+        }
+    }
+    (void)wideSpot;
+
+    // Upload the table and tell the scene's light buffer where each light's map is
+    m_lightBuffer = vk::Buffer(m_ctx, std::max<size_t>(m_lights.size(), 1) * sizeof(PassLight),
+                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::DeviceLocal,
+                               "shared/shadow.lights");
+    m_lightBuffer.uploadVector(m_lights);
+    std::vector<int> shadowIndex(gpuScene.lightCount(), -1);
+    for (size_t i = 0; i < shadowIndex.size() && i < m_sceneLightCount; ++i) {
+        if (m_lights[i].shadow.x != float(kShadowNone)) shadowIndex[i] = int(i);
+    }
+    if (!shadowIndex.empty()) m_scene.setLightShadowIndices(shadowIndex);
+}
+
+void ShadowMaps::createImages() {
+    // A 1x1 placeholder stands in for each category the scene lacks
+    const uint32_t res = m_settings.resolution;
+    const uint32_t areaRes = m_settings.areaResolution;
+    m_maps2D = m_layers2D > 0
+                   ? makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, res, m_layers2D, "maps2d")
+                   : makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, 1, 1, "maps2d_empty");
+    m_cubes = m_cubeCount > 0
+                  ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, res, 6 * m_cubeCount, "cubes")
+                  : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6, "cubes_empty");
+    m_areaCubes = m_areaCubeCount > 0
+                      ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, areaRes,
+                                          6 * m_areaCubeCount, "area_cubes")
+                      : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6, "area_cubes_empty");
+    if (!m_jobs.empty()) {
+        uint32_t depthRes = 0;
+        for (const Job& job : m_jobs) {
+            depthRes = std::max(depthRes, job.kind == kShadowAreaCube ? areaRes : res);
+        }
+        vk::ImageDesc depth;
+        depth.format = kDepthFormat;
+        depth.width = depthRes;
+        depth.height = depthRes;
+        depth.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+        depth.name = "shared/shadow.depth";
+        m_depth = vk::Image(m_ctx, depth);
+    }
+    m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
+        const VkClearColorValue far{{kNoOccluder, 0.0f, 0.0f, 0.0f}};
+        for (vk::Image* image : {&m_maps2D, &m_cubes, &m_areaCubes}) {
+            image->clearColor(cmd, far);
+            image->transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+        }
+    });
+}
+
+void ShadowMaps::record(VkCommandBuffer cmd) {
+    if (m_jobs.empty() || m_scene.triangleCount() == 0) return;
+    for (vk::Image* image : {&m_maps2D, &m_cubes, &m_areaCubes}) {
+        image->transition(cmd, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+    }
+    m_pipeline.bind(cmd);
+    VkDescriptorSet set = m_scene.set().handle();
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_layout.handle(), 0, 1, &set, 0,
+                            nullptr);
+    for (const Job& job : m_jobs) {
+        // The shared depth buffer: full barrier between renders (write after write)
+        m_depth.transition(cmd, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+        vk::Image& target = job.kind == kShadowMap2D ? m_maps2D
+                            : job.kind == kShadowCube ? m_cubes
+                                                      : m_areaCubes;
+        const uint32_t size = target.width();
+        vk::ColorTarget color{target.layerView(job.layer, 0),
+                              VkClearColorValue{{kNoOccluder, 0.0f, 0.0f, 0.0f}},
+                              VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL};
+        vk::DepthTarget depth;
+        depth.view = m_depth.view();
+        depth.clear = 0.0f;  // reversed-Z
+        depth.store = false;
+        vk::RenderingScope scope(cmd, {size, size}, {color}, depth);
+        vkCmdPushConstants(cmd, m_layout.handle(), m_layout.pushStages(), 0, sizeof(job.push),
+                           &job.push);
+        vkCmdDraw(cmd, 3 * m_scene.triangleCount(), 1, 0, 0);
+    }
+    for (vk::Image* image : {&m_maps2D, &m_cubes, &m_areaCubes}) {
+        image->transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    }
+}
+
+std::vector<vk::DescriptorBinding> ShadowMaps::descriptorBindings(uint32_t firstBinding,
+                                                                  VkShaderStageFlags stages) {
+    const VkDescriptorType sampled = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    return {
+        {firstBinding + 0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages},
+        {firstBinding + 1, sampled, 1, stages},
+        {firstBinding + 2, sampled, 1, stages},
+        {firstBinding + 3, sampled, 1, stages},
+    };
+}
+
+void ShadowMaps::writeDescriptors(vk::DescriptorSet& set, uint32_t firstBinding) {
+    const VkImageLayout layout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    set.writeBuffer(firstBinding + 0, m_lightBuffer);
+    set.writeSampledImage(firstBinding + 1, m_maps2D.view(), m_sampler.handle(), layout);
+    set.writeSampledImage(firstBinding + 2, m_cubes.mipView(0), m_sampler.handle(), layout);
+    set.writeSampledImage(firstBinding + 3, m_areaCubes.mipView(0), m_sampler.handle(), layout);
+}
+
+}  // namespace gilab

@@ -1,0 +1,43 @@
+#include "core/passes/shared_passes.h"
+
+#include <optional>
+
+#include "core/gpu/gpu_scene.h"
+#include "core/vk/context.h"
+#include "core/vk/timer.h"
+
+namespace gilab {
+
+SharedPasses::SharedPasses(vk::Context& ctx, vk::GpuScene& scene, uint32_t width, uint32_t height,
+                           const SharedPassSettings& settings)
+    : m_width(width), m_height(height), m_settings(settings) {
+    m_gbuffer = std::make_unique<GBufferPass>(ctx, scene, width, height);
+    m_shadows = std::make_unique<ShadowMaps>(ctx, scene, settings.shadow,
+                                             settings.areaLightSamples);
+    m_direct = std::make_unique<DirectLightPass>(ctx, scene, m_gbuffer->images(), *m_shadows);
+}
+
+void SharedPasses::recordShadows(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+    std::optional<vk::ScopedGpuPass> scope;
+    if (timer) scope.emplace(*timer, cmd, "shadow_maps");
+    m_shadows->record(cmd);
+    m_shadowsValid = true;
+}
+
+void SharedPasses::record(VkCommandBuffer cmd, const Camera& camera, vk::GpuTimer* timer) {
+    {
+        std::optional<vk::ScopedGpuPass> scope;
+        if (timer) scope.emplace(*timer, cmd, "gbuffer");
+        m_gbuffer->record(cmd, camera);
+    }
+    if (!m_shadowsValid) recordShadows(cmd, timer);
+    {
+        std::optional<vk::ScopedGpuPass> scope;
+        if (timer) scope.emplace(*timer, cmd, "direct_light");
+        m_direct->record(cmd, camera);
+    }
+}
+
+std::vector<std::string> SharedPasses::skippedPasses() const { return m_shadows->skippedPasses(); }
+
+}  // namespace gilab

@@ -1,0 +1,63 @@
+#pragma once
+/**
+ * A scene description file (docs/scenes.md) parsed and validated, before any geometry is
+ * loaded. Parsing is cheap, so the loader validates the base and every variant up front.
+ */
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/scene/procedural_cornell.h"
+#include "core/scene/scene.h"
+
+namespace gilab {
+
+class JsonNode;
+
+/** "camera": each field present overrides the camera the geometry source provides. */
+struct CameraOverride {
+    std::optional<glm::vec3> position;
+    std::optional<glm::vec3> target;
+    std::optional<glm::vec3> up;
+    std::optional<float> vfovRad;
+    std::optional<float> nearZ;
+    std::optional<float> farZ;
+    bool placesCamera() const { return position && target; }
+};
+
+/** One entry of "material_overrides" (applies to every material with that name). */
+struct MaterialOverride {
+    std::string name;
+    std::optional<glm::vec4> baseColor;  // rgb + alpha (alpha kept when given as RGB)
+    bool baseColorHasAlpha = false;
+    std::optional<float> roughness;
+    std::optional<float> metallic;
+    std::optional<glm::vec3> emissive;
+};
+
+struct SceneDescription {
+    std::string context;  // "scenes/x.json" or `scenes/x.json (variant "spot")`, for messages
+    std::optional<std::string> name;
+    std::string gltfPath;  // resolved against the file's folder; empty when procedural
+    std::optional<CornellBoxParams> cornellBox;
+    std::optional<CameraOverride> camera;
+    std::optional<glm::ivec2> resolution;
+    std::optional<float> exposureEv;
+    std::optional<std::vector<Light>> lights;  // replaces the source's lights
+    std::vector<Light> extraLights;            // appended
+    std::vector<MaterialOverride> materialOverrides;
+    bool removeEmissive = false;
+};
+
+/**
+ * Parses one description object (variants already merged in, "variants" removed). `baseDir`
+ * is the folder relative paths are resolved against. Throws gilab::Error naming the key.
+ */
+SceneDescription parseSceneDescription(const JsonNode& root, const std::string& baseDir);
+
+/** Parses one light object of "lights" / "extra_lights". */
+Light parseLight(const JsonNode& node);
+
+}  // namespace gilab

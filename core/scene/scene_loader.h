@@ -1,0 +1,34 @@
+#pragma once
+/**
+ * Scene loading: JSON scene descriptions (docs/scenes.md), glTF 2.0 files and the built-in
+ * default scene. Every loader flattens to world space, fills `Scene::warnings` and
+ * `Scene::loadedFiles`, calls `Scene::computeCaps()` last, and throws gilab::Error with a
+ * message naming the file and the problem.
+ */
+#include <string>
+
+#include "core/scene/scene.h"
+
+namespace gilab {
+
+/**
+ * Loads a scene description (.json). `path` may carry the variant as `file.json#variant`;
+ * giving it both ways with different names is an error. Relative paths inside the file are
+ * relative to the file's folder. `Scene::name` = file stem (or the "name" key) + "#variant".
+ */
+Scene loadSceneFile(const std::string& path, const std::string& variant = "");
+
+/**
+ * Loads a glTF 2.0 file (.gltf or .glb): geometry, materials, textures, the first camera and
+ * KHR_lights_punctual lights. Without a camera in the file, a camera framing the bounds is
+ * made and a warning added.
+ */
+Scene loadGltf(const std::string& path);
+
+/** The scene used when none is given: the procedural Cornell box with its ceiling area light. */
+Scene makeBuiltinDefaultScene();
+
+/** A camera looking at the centre of `bounds` along -z from far enough to see all of it. */
+Camera makeFramingCamera(const Bounds& bounds);
+
+}  // namespace gilab

@@ -1,0 +1,188 @@
+#include "core/technique/frame_harness.h"
+
+#include <map>
+
+#include "core/gpu/gpu_scene.h"
+#include "core/passes/shared_passes.h"
+#include "core/scene/scene.h"
+#include "core/technique/registry.h"
+#include "core/util/error.h"
+#include "core/util/progress.h"
+#include "core/vk/context.h"
+#include "core/vk/image.h"
+
+namespace gilab {
+namespace {
+
+std::unique_ptr<vk::Image> makeFrameImage(vk::Context& ctx, uint32_t w, uint32_t h,
+                                          const std::string& name) {
+    vk::ImageDesc desc;
+    desc.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    desc.width = w;
+    desc.height = h;
+    desc.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                 VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    desc.name = name;
+    return std::make_unique<vk::Image>(ctx, desc);
+}
+
+/** Reads an RGBA32F (or other float-convertible) image into a CPU image of `channels`. */
+Image readImage(vk::Context& ctx, vk::Image& image, int channels) {
+    uint32_t srcChannels = 0;
+    const std::vector<float> texels = image.readbackFloat(ctx, 0, 0, &srcChannels);
+    const int w = int(image.desc().width), h = int(image.desc().height);
+    Image out(w, h, channels);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < channels; ++c) {
+                const size_t i = (size_t(y) * size_t(w) + size_t(x)) * srcChannels;
+                out.at(x, y, c) = c < int(srcChannels) ? texels[i + size_t(c)] : 0.0f;
+            }
+    return out;
+}
+
+}  // namespace
+
+FrameHarness::FrameHarness(vk::Context& ctx, const Scene& scene, const std::string& techniqueId,
+                           const ParamSet& techniqueParams, const ParamSet& sharedParams)
+    : m_ctx(ctx),
+      m_scene(scene),
+      m_technique(TechniqueRegistry::instance().create(techniqueId)),
+      m_params(techniqueParams),
+      m_sharedParams(sharedParams) {
+    if (m_params.owner() != techniqueId)
+        throw Error("parameters of \"" + m_params.owner() + "\" given to technique \"" +
+                    techniqueId + "\"");
+    m_support = m_technique->checkSupport(scene, m_params);
+    if (scene.triangleCount() == 0) m_support = {false, "the scene has no triangles"};
+    if (scene.settings.width < 1 || scene.settings.height < 1)
+        m_support = {false, "the scene's resolution is empty"};
+}
+
+FrameHarness::~FrameHarness() = default;
+
+const TechniqueInfo& FrameHarness::info() const { return m_technique->info(); }
+
+TechniqueContext FrameHarness::makeContext() {
+    TechniqueContext ctx{m_ctx,
+                         m_scene,
+                         *m_gpuScene,
+                         *m_shared,
+                         m_params,
+                         uint32_t(m_scene.settings.width),
+                         uint32_t(m_scene.settings.height),
+                         m_timer.get(),
+                         &m_skipped,
+                         &m_notes,
+                         m_technique->info().id};
+    return ctx;
+}
+
+SetupTiming FrameHarness::setup() {
+    if (!m_support.supported)
+        throw Error(m_technique->info().id + " cannot run on " + m_scene.name + ": " +
+                    m_support.reason);
+    SetupTiming t;
+    const uint32_t w = uint32_t(m_scene.settings.width), h = uint32_t(m_scene.settings.height);
+    Stopwatch total;
+
+    Stopwatch sw;
+    m_gpuScene = std::make_unique<vk::GpuScene>(m_ctx, m_scene);
+    t.sceneUploadMs = sw.elapsedMs();
+
+    sw.restart();
+    m_shared = std::make_unique<SharedPasses>(m_ctx, *m_gpuScene, w, h,
+                                              sharedSettingsFromParams(m_sharedParams));
+    for (const std::string& s : m_shared->skippedPasses()) m_skipped.push_back("shared/" + s);
+    m_indirect = makeFrameImage(m_ctx, w, h, "shared/frame.indirect");
+    m_timer = std::make_unique<vk::GpuTimer>(m_ctx, 128);
+    t.sharedSetupMs = sw.elapsedMs();
+
+    sw.restart();
+    TechniqueContext ctx = makeContext();
+    m_technique->setup(ctx);
+    t.techniqueSetupMs = sw.elapsedMs();
+    t.totalMs = total.elapsedMs();
+    m_ready = true;
+    return t;
+}
+
+FrameTiming FrameHarness::renderFrame() {
+    if (!m_ready) throw Error("FrameHarness::renderFrame() called before setup()");
+    FrameTiming t;
+    Stopwatch sw;
+    TechniqueContext ctx = makeContext();
+    m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
+        m_timer->reset(cmd);
+        m_shared->record(cmd, m_scene.camera, m_timer.get());
+        m_indirect->clearColor(cmd, VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}});
+        FrameTargets targets{*m_indirect, m_shared->direct()};
+        m_technique->render(ctx, cmd, targets);
+    });
+    t.cpuMs = sw.elapsedMs();
+    t.passes = m_timer->resolve();
+    return t;
+}
+
+void FrameHarness::updateParams(const ParamSet& techniqueParams) {
+    const std::vector<std::string> changed = m_params.changedKeys(techniqueParams);
+    m_params = techniqueParams;
+    if (changed.empty() || !m_ready) return;
+    TechniqueContext ctx = makeContext();
+    m_technique->onParamsChanged(ctx, changed);
+}
+
+std::vector<ImageLayer> FrameHarness::readLayers() {
+    if (!m_ready) throw Error("FrameHarness::readLayers() called before setup()");
+    GBuffer& gb = m_shared->gbuffer();
+    Image indirect = readImage(m_ctx, *m_indirect, 3);
+    Image direct = readImage(m_ctx, m_shared->direct(), 3);
+    Image emission = readImage(m_ctx, gb.emission, 3);
+    Image albedo = readImage(m_ctx, gb.albedo, 3);
+    Image normal = readImage(m_ctx, gb.normal, 3);
+    Image position = readImage(m_ctx, gb.position, 4);
+
+    // Compose final = emission + direct + indirect, the same way for every technique.
+    Image final(indirect.width(), indirect.height(), 3);
+    for (size_t i = 0; i < final.values().size(); ++i)
+        final.values()[i] = emission.values()[i] + direct.values()[i] + indirect.values()[i];
+
+    // Depth = distance along the camera's forward axis; 0 where there is no geometry.
+    Image depth(position.width(), position.height(), 1);
+    const glm::vec3 eye = m_scene.camera.position, forward = m_scene.camera.forward();
+    for (int y = 0; y < depth.height(); ++y)
+        for (int x = 0; x < depth.width(); ++x) {
+            if (position.at(x, y, 3) <= 0.0f) continue;
+            const glm::vec3 p{position.at(x, y, 0), position.at(x, y, 1), position.at(x, y, 2)};
+            depth.at(x, y, 0) = glm::dot(p - eye, forward);
+        }
+
+    std::vector<ImageLayer> layers;
+    layers.push_back({"final", std::move(final)});
+    layers.push_back({"indirect", std::move(indirect)});
+    layers.push_back({"direct", std::move(direct)});
+    layers.push_back({"emission", std::move(emission)});
+    layers.push_back({"albedo", std::move(albedo)});
+    layers.push_back({"normal", std::move(normal)});
+    layers.push_back({"depth", std::move(depth)});
+    for (const DebugView& view : m_technique->debugViews())
+        if (view.image) layers.push_back({"debug_" + view.name, readImage(m_ctx, *view.image, 3)});
+    return layers;
+}
+
+MemoryReport FrameHarness::memory() const {
+    MemoryReport report;
+    const vk::MemoryTracker& tracker = m_ctx.memory();
+    report.totalBytes = tracker.total();
+    report.peakBytes = tracker.peak();
+    std::map<std::string, uint64_t> owners;
+    for (const auto& [tag, bytes] : tracker.byTag()) {
+        report.byTag.emplace_back(tag, bytes);
+        const size_t slash = tag.find('/');
+        owners[slash == std::string::npos ? tag : tag.substr(0, slash)] += bytes;
+    }
+    report.byOwner.assign(owners.begin(), owners.end());
+    return report;
+}
+
+}  // namespace gilab

@@ -1,0 +1,89 @@
+#pragma once
+/**
+ * Runs one technique on one scene: uploads the scene, builds the shared passes, sets the
+ * technique up (timed apart from frames), records and submits frames with per-pass GPU
+ * timestamps, and reads the layers back as linear HDR images.
+ *
+ * Frame = shared passes (G-buffer, shadow maps, direct light) + technique.render() writing the
+ * indirect layer. Composition final = emission + direct + indirect happens on read-back, in one
+ * place (readLayers), so every technique is composed the same way.
+ */
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "core/image/image.h"
+#include "core/params/params.h"
+#include "core/technique/technique.h"
+#include "core/vk/timer.h"
+
+namespace gilab {
+
+/** Parameters of the shared passes, owner "shared" (set as shared.<key> on the command line). */
+std::vector<ParamSpec> sharedPassParamSpecs();
+ParamSet defaultSharedParams();
+
+struct SetupTiming {
+    double sceneUploadMs = 0.0;     // CPU wall time: GpuScene creation (buffers, textures)
+    double sharedSetupMs = 0.0;     // CPU wall time: shared pass creation (pipelines, images)
+    double techniqueSetupMs = 0.0;  // CPU wall time of technique.setup()
+    double totalMs = 0.0;
+};
+
+struct FrameTiming {
+    double cpuMs = 0.0;  // record + submit + wait, CPU wall time
+    std::vector<vk::PassTime> passes;
+};
+
+/** Bytes of device memory by owner: "scene", "shared", the technique id, ... */
+struct MemoryReport {
+    uint64_t totalBytes = 0;
+    uint64_t peakBytes = 0;
+    std::vector<std::pair<std::string, uint64_t>> byOwner;
+    std::vector<std::pair<std::string, uint64_t>> byTag;
+};
+
+class FrameHarness {
+public:
+    FrameHarness(vk::Context& ctx, const Scene& scene, const std::string& techniqueId,
+                 const ParamSet& techniqueParams, const ParamSet& sharedParams);
+    ~FrameHarness();
+    FrameHarness(const FrameHarness&) = delete;
+    FrameHarness& operator=(const FrameHarness&) = delete;
+
+    const TechniqueInfo& info() const;
+    /** Whether the technique can run on the scene (decided in the constructor). */
+    const SupportResult& support() const { return m_support; }
+
+    /** Throws gilab::Error if the technique does not support the scene. */
+    SetupTiming setup();
+    FrameTiming renderFrame();
+    /** Changes technique parameters between frames; calls onParamsChanged with changed keys. */
+    void updateParams(const ParamSet& techniqueParams);
+
+    /** final, indirect, direct, emission, albedo, normal, depth, then the debug views. */
+    std::vector<ImageLayer> readLayers();
+
+    const std::vector<std::string>& skipped() const { return m_skipped; }
+    const std::vector<std::string>& notes() const { return m_notes; }
+    MemoryReport memory() const;
+
+private:
+    TechniqueContext makeContext();
+
+    vk::Context& m_ctx;
+    const Scene& m_scene;
+    std::unique_ptr<Technique> m_technique;
+    ParamSet m_params;
+    ParamSet m_sharedParams;
+    SupportResult m_support;
+    std::unique_ptr<vk::GpuScene> m_gpuScene;
+    std::unique_ptr<SharedPasses> m_shared;
+    std::unique_ptr<vk::Image> m_indirect;
+    std::unique_ptr<vk::GpuTimer> m_timer;
+    std::vector<std::string> m_skipped;
+    std::vector<std::string> m_notes;
+    bool m_ready = false;
+};
+
+}  // namespace gilab

@@ -1,0 +1,36 @@
+#include "core/technique/technique.h"
+
+#include "core/scene/scene.h"
+
+namespace gilab {
+
+std::string TechniqueContext::tag(const std::string& resource) const {
+    return techniqueId + "/" + resource;
+}
+
+void TechniqueContext::skip(const std::string& pass, const std::string& reason) const {
+    if (skipped) skipped->push_back(techniqueId + "/" + pass + ": " + reason);
+}
+
+void TechniqueContext::note(const std::string& text) const {
+    if (notes) notes->push_back(techniqueId + ": " + text);
+}
+
+SupportResult Technique::checkSupport(const Scene& scene, const ParamSet&) const {
+    const FeatureSupport& s = m_info.supports;
+    const SceneCaps& caps = scene.caps;
+    auto no = [](const std::string& what) { return SupportResult{false, what}; };
+    if (caps.hasPointLights && !s.pointLights) return no("does not support point lights");
+    if (caps.hasSpotLights && !s.spotLights) return no("does not support spot lights");
+    if (caps.hasDirectionalLights && !s.directionalLights)
+        return no("does not support directional lights");
+    if (caps.hasEmissive && !s.emissiveSurfaces)
+        return no("does not support emissive surfaces as light sources");
+    return {};
+}
+
+void Technique::onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys) {
+    if (ctx.params.changesNeedRebuild(keys)) setup(ctx);
+}
+
+}  // namespace gilab

@@ -1,0 +1,117 @@
+#pragma once
+/**
+ * The Technique interface every GI method implements, plugin style.
+ *
+ * A technique lives in techniques/<id>/ (C++) and shaders/<id>/ (GLSL), has one line in the
+ * top-level CMake technique table, and registers itself with GILAB_REGISTER_TECHNIQUE at the end
+ * of its .cpp. Nothing in core/ names a technique.
+ *
+ * Life cycle (driven by the harness, core/technique/frame_harness.h):
+ *   info()            static description: id, parameters, claimed bounces, supported features
+ *   checkSupport()    can it run on this scene? If not, the harness skips it with the reason
+ *   setup()           precomputation (voxelization, clustering, ...), timed apart from frames
+ *   onParamsChanged() only the keys that changed; the default re-runs setup() for Rebuild keys
+ *   render()          records the per-frame passes into the frame's command buffer; it must write
+ *                     the indirect layer (linear HDR radiance, RGBA32F) and may add debug views
+ * The harness owns the shared passes (G-buffer, shadow maps, direct light), the composition
+ * final = emission + direct + indirect, timing, read-back, NaN/Inf counting and memory reports.
+ */
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "core/params/params.h"
+
+namespace gilab {
+
+struct Scene;
+
+class SharedPasses;
+struct GBuffer;
+namespace vk {
+class Context;
+class Image;
+class GpuTimer;
+class GpuScene;
+}  // namespace vk
+
+/** Number of indirect bounces a technique claims; compared with the matching reference. */
+inline constexpr int kAllBounces = -1;
+
+/** Scene features a technique can consume. */
+struct FeatureSupport {
+    bool pointLights = true;
+    bool spotLights = true;
+    bool directionalLights = true;
+    bool emissiveSurfaces = true;  // emitters as light sources for the indirect light
+};
+
+struct TechniqueInfo {
+    std::string id;           // = the folder name, snake_case
+    std::string description;  // one line
+    std::string citation;     // the paper it implements ("" for the baseline)
+    std::vector<ParamSpec> params;
+    int indirectBounces = 0;  // 0 = direct only, n >= 1, or kAllBounces
+    FeatureSupport supports;
+};
+
+struct SupportResult {
+    bool supported = true;
+    std::string reason;  // why not, e.g. "needs a shadow-mapped light; scene has only emitters"
+};
+
+/** A named image a technique exposes for inspection (written to the EXR as an extra layer). */
+struct DebugView {
+    std::string name;
+    vk::Image* image = nullptr;  // RGBA32F at frame resolution, GENERAL or SHADER_READ_ONLY layout
+};
+
+/** What a technique sees while it sets up and renders. */
+struct TechniqueContext {
+    vk::Context& vk;
+    const Scene& scene;
+    const vk::GpuScene& gpuScene;
+    SharedPasses& shared;  // G-buffer, shadow maps, direct light (core/passes/shared_passes.h)
+    const ParamSet& params;
+    uint32_t width = 0;
+    uint32_t height = 0;
+    vk::GpuTimer* timer = nullptr;  // name sub-passes with vk::ScopedGpuPass(*timer, cmd, "...")
+    std::vector<std::string>* skipped = nullptr;  // "pass: reason" lines for the run's metadata
+    std::vector<std::string>* notes = nullptr;    // other facts worth recording
+
+    /** Memory tag for a resource owned by the running technique: "<id>/<resource>". */
+    std::string tag(const std::string& resource) const;
+    void skip(const std::string& pass, const std::string& reason) const;
+    void note(const std::string& text) const;
+    std::string techniqueId;
+};
+
+/** The images of one frame. `indirect` is cleared to zero before render() is called. */
+struct FrameTargets {
+    vk::Image& indirect;  // RGBA32F storage image, GENERAL layout: write indirect radiance here
+    vk::Image& direct;    // shared direct light; a technique may overwrite it (declare it in notes)
+};
+
+class Technique {
+public:
+    virtual ~Technique() = default;
+
+    /** Default: compares the scene's lights and emitters with info().supports. */
+    virtual SupportResult checkSupport(const Scene& scene, const ParamSet& params) const;
+    virtual void setup(TechniqueContext& ctx) = 0;
+    /** Default: runs setup() again when any changed key has stage Rebuild. */
+    virtual void onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys);
+    /** Records the frame's passes. Must not submit; the harness submits and waits. */
+    virtual void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) = 0;
+    virtual std::vector<DebugView> debugViews() { return {}; }
+
+    const TechniqueInfo& info() const { return m_info; }
+
+private:
+    friend class TechniqueRegistry;
+    TechniqueInfo m_info;
+};
+
+}  // namespace gilab

@@ -1,0 +1,153 @@
+// `gilab render`: one technique, one scene -> <out>/<technique>.exr/.png/.json
+#include <charconv>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "core/image/image_io.h"
+#include "core/scene/scene_loader.h"
+#include "core/technique/frame_harness.h"
+#include "core/technique/registry.h"
+#include "core/util/error.h"
+#include "core/util/progress.h"
+#include "core/vk/context.h"
+#include "experiments/cli/cli.h"
+#include "experiments/cli/run_metadata.h"
+
+namespace gilab::cli {
+namespace {
+
+void applyResolution(Scene& scene, const std::string& text) {
+    if (text.empty()) return;
+    const size_t x = text.find('x');
+    int w = 0, h = 0;
+    const bool ok = x != std::string::npos &&
+                    std::from_chars(text.data(), text.data() + x, w).ptr == text.data() + x &&
+                    std::from_chars(text.data() + x + 1, text.data() + text.size(), h).ptr ==
+                        text.data() + text.size();
+    if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw Error("--resolution \"" + text + "\": expected WxH with 1 <= W, H <= 16384");
+    scene.settings.width = w;
+    scene.settings.height = h;
+}
+
+/** Splits --set assignments between the technique's and the shared passes' parameter sets. */
+void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
+                      ParamSet& shared) {
+    for (const std::string& a : assignments) {
+        auto [key, value] = splitAssignment(a);
+        if (key.rfind("shared.", 0) == 0)
+            shared.set(key.substr(7), value);
+        else
+            technique.set(key, value);
+    }
+}
+
+void writeJson(const std::filesystem::path& path, const nlohmann::ordered_json& json) {
+    const std::filesystem::path tmp = path.string() + ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << json.dump(2) << "\n";
+        if (!out) throw Error("cannot write " + tmp.string());
+    }
+    std::filesystem::rename(tmp, path);
+}
+
+}  // namespace
+
+int runRender(const RenderOptions& options) {
+    Progress::setQuiet(options.quiet);
+    Scene scene = loadSceneOrDefault(options.scenePath);
+    applyResolution(scene, options.resolution);
+    for (const std::string& w : scene.warnings)
+        std::fprintf(stderr, "gilab: %s: warning: %s\n", scene.name.c_str(), w.c_str());
+
+    const TechniqueRegistry& registry = TechniqueRegistry::instance();
+    ParamSet params = registry.defaultParams(options.technique);
+    ParamSet shared = defaultSharedParams();
+    applyAssignments(options.assignments, params, shared);
+
+    vk::ContextOptions ctxOptions;
+    ctxOptions.validation = options.validation;
+    ctxOptions.deviceFilter = options.device;
+    vk::Context ctx(ctxOptions);
+
+    const std::filesystem::path outDir(options.outDir);
+    std::filesystem::create_directories(outDir);
+    const std::filesystem::path base = outDir / options.technique;
+
+    nlohmann::ordered_json meta;
+    meta["status"] = "running";
+    meta["provenance"] = provenanceJson(options.commandLine);
+    meta["device"] = deviceJson(ctx);
+    meta["scene"] = sceneToJson(scene);
+    meta["technique"] = {{"id", options.technique},
+                         {"indirect_bounces", registry.get(options.technique).indirectBounces},
+                         {"params", params.toOrderedJson()}};
+    meta["shared_params"] = shared.toOrderedJson();
+
+    FrameHarness harness(ctx, scene, options.technique, params, shared);
+    if (!harness.support().supported) {
+        meta["status"] = "unsupported";
+        meta["reason"] = harness.support().reason;
+        writeJson(base.string() + ".json", meta);
+        std::fprintf(stderr, "gilab: %s skipped on %s: %s\n", options.technique.c_str(),
+                     scene.name.c_str(), harness.support().reason.c_str());
+        return kExitUnsupported;
+    }
+
+    Progress setupProgress("set-up " + options.technique + " on " + scene.name);
+    const SetupTiming setup = harness.setup();
+    setupProgress.finish();
+
+    const int total = options.warmupFrames + options.frames;
+    std::vector<FrameTiming> frames;
+    Progress frameProgress("frames", size_t(total));
+    for (int i = 0; i < total; ++i) {
+        FrameTiming t = harness.renderFrame();
+        if (i >= options.warmupFrames) frames.push_back(std::move(t));
+        frameProgress.update(size_t(i + 1));
+    }
+    frameProgress.finish();
+
+    const std::vector<ImageLayer> layers = harness.readLayers();
+    size_t nonFinite = 0;
+    meta["nonfinite"] = finiteJson(layers, &nonFinite);
+    meta["timing"] = timingJson(setup, frames, options.warmupFrames);
+    meta["memory"] = memoryJson(harness.memory());
+    meta["skipped_passes"] = harness.skipped();
+    meta["notes"] = harness.notes();
+    meta["validation"] = {{"errors", ctx.validationErrorCount()},
+                          {"warnings", ctx.validationWarningCount()},
+                          {"messages", ctx.validationMessages()}};
+
+    writeExrLayers(base.string() + ".exr", layers);
+    ToneMap tm;
+    tm.exposureEv = scene.settings.exposureEv;
+    writePngTonemapped(base.string() + ".png", layers.front().image, tm);
+    meta["outputs"] = {{"exr", base.string() + ".exr"}, {"png", base.string() + ".png"}};
+    meta["status"] = nonFinite ? "nonfinite" : "ok";
+    writeJson(base.string() + ".json", meta);
+
+    const auto& cpu = meta["timing"]["frame_cpu_ms"];
+    const auto& gpu = meta["timing"]["frame_gpu_ms"];
+    std::printf("%s on %s (%dx%d, %s): set-up %.1f ms, frame %.2f ms CPU / %.2f ms GPU (median of "
+                "%d)\n",
+                options.technique.c_str(), scene.name.c_str(), scene.settings.width,
+                scene.settings.height, ctx.deviceName().c_str(), setup.totalMs,
+                cpu["median"].is_number() ? cpu["median"].get<double>() : -1.0,
+                gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
+    for (const std::string& s : harness.skipped()) std::printf("  skipped %s\n", s.c_str());
+    std::printf("  wrote %s.{exr,png,json}\n", base.string().c_str());
+    if (ctx.validationErrorCount() > 0)
+        std::fprintf(stderr, "gilab: %u Vulkan validation errors (see the JSON sidecar)\n",
+                     ctx.validationErrorCount());
+    if (nonFinite) {
+        std::fprintf(stderr, "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s.json)\n",
+                     nonFinite, base.string().c_str());
+        return kExitNonFinite;
+    }
+    return kExitOk;
+}
+
+}  // namespace gilab::cli

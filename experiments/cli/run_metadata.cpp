@@ -1,0 +1,191 @@
+#include "experiments/cli/run_metadata.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <ctime>
+#include <fstream>
+#include <map>
+#include <thread>
+
+#include "core/util/build_info.h"
+#include "core/util/stats.h"
+#include "core/vk/context.h"
+
+namespace gilab::cli {
+namespace {
+
+std::string cpuModel() {
+    std::ifstream in("/proc/cpuinfo");
+    std::string line;
+    while (std::getline(in, line)) {
+        if (line.rfind("model name", 0) == 0) {
+            const size_t colon = line.find(':');
+            if (colon != std::string::npos) return line.substr(colon + 2);
+        }
+    }
+    return "unknown";
+}
+
+std::string hostName() {
+    char buf[256] = {};
+    return gethostname(buf, sizeof buf - 1) == 0 ? std::string(buf) : "unknown";
+}
+
+nlohmann::ordered_json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+
+/** NaN is not valid JSON: a NaN measurement is written as null. */
+nlohmann::ordered_json number(double v) {
+    return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
+
+nlohmann::ordered_json summaryJson(const std::vector<double>& values) {
+    const Summary s = summarize(values);
+    return {{"median", number(s.median)}, {"q1", number(s.q1)},   {"q3", number(s.q3)},
+            {"iqr", number(s.iqr())},     {"min", number(s.min)}, {"max", number(s.max)},
+            {"samples", values}};
+}
+
+}  // namespace
+
+std::string isoDateUtc() {
+    const std::time_t now = std::time(nullptr);
+    std::tm tm{};
+    gmtime_r(&now, &tm);
+    char buf[32];
+    std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+    return buf;
+}
+
+nlohmann::ordered_json provenanceJson(const std::string& commandLine) {
+    return {{"gilab_version", build::kVersion},
+            {"git_commit", build::kGitCommit},
+            {"build_type", build::kBuildType},
+            {"compiler", build::kCompiler},
+            {"date", isoDateUtc()},
+            {"host", hostName()},
+            {"cpu", cpuModel()},
+            {"hardware_threads", std::thread::hardware_concurrency()},
+            {"command_line", commandLine}};
+}
+
+nlohmann::ordered_json deviceJson(const vk::Context& ctx) {
+    nlohmann::ordered_json candidates = nlohmann::ordered_json::array();
+    for (const vk::DeviceCandidate& c : ctx.candidates())
+        candidates.push_back({{"name", c.name}, {"chosen", c.chosen}, {"reason", c.reason}});
+    return {{"name", ctx.deviceName()},
+            {"type", ctx.deviceType()},
+            {"driver", ctx.driverName()},
+            {"driver_info", ctx.driverInfo()},
+            {"vulkan_api", ctx.apiVersion()},
+            {"validation", ctx.validationEnabled()},
+            {"extensions", ctx.enabledExtensions()},
+            {"candidates", candidates}};
+}
+
+nlohmann::ordered_json sceneToJson(const Scene& scene) {
+    const SceneCaps& c = scene.caps;
+    nlohmann::ordered_json features = nlohmann::ordered_json::array();
+    auto add = [&](bool on, const char* name) {
+        if (on) features.push_back(name);
+    };
+    add(c.hasEmissive, "emissive");
+    add(c.hasGlossy, "glossy");
+    add(c.hasTextures, "textures");
+    add(c.hasAlphaMask, "alpha_mask");
+    add(c.hasPointLights, "point_lights");
+    add(c.hasSpotLights, "spot_lights");
+    add(c.hasDirectionalLights, "directional_lights");
+    const char* kLightTypes[] = {"point", "spot", "directional"};
+    nlohmann::ordered_json lights = nlohmann::ordered_json::array();
+    for (const Light& l : scene.lights) {
+        lights.push_back({{"name", l.name},
+                          {"type", kLightTypes[int(l.type)]},
+                          {"position", vec3Json(l.position)},
+                          {"direction", vec3Json(l.direction)},
+                          {"intensity", vec3Json(l.intensity)},
+                          {"inner_cone_rad", l.innerConeRad},
+                          {"outer_cone_rad", l.outerConeRad}});
+    }
+    return {{"name", scene.name},
+            {"source", scene.sourcePath},
+            {"files", scene.loadedFiles},
+            {"resolution", {scene.settings.width, scene.settings.height}},
+            {"exposure_ev", scene.settings.exposureEv},
+            {"camera",
+             {{"position", vec3Json(scene.camera.position)},
+              {"target", vec3Json(scene.camera.target)},
+              {"up", vec3Json(scene.camera.up)},
+              {"vfov_deg", scene.camera.vfovRad * 180.0 / M_PI}}},
+            {"lights", lights},
+            {"caps",
+             {{"triangles", c.triangleCount},
+              {"emissive_triangles", c.emissiveTriangleCount},
+              {"materials", scene.materials.size()},
+              {"textures", scene.textures.size()},
+              {"features", features},
+              {"bounds_min", vec3Json(c.bounds.lo)},
+              {"bounds_max", vec3Json(c.bounds.hi)}}},
+            {"warnings", scene.warnings}};
+}
+
+nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
+                                  int warmupFrames) {
+    std::vector<double> cpu;
+    std::vector<std::string> order;
+    std::map<std::string, std::vector<double>> gpu, record;
+    for (const FrameTiming& f : frames) {
+        cpu.push_back(f.cpuMs);
+        for (const vk::PassTime& p : f.passes) {
+            if (!gpu.count(p.name)) order.push_back(p.name);
+            gpu[p.name].push_back(p.gpuMs);
+            record[p.name].push_back(p.cpuRecordMs);
+        }
+    }
+    nlohmann::ordered_json passes = nlohmann::ordered_json::array();
+    std::vector<double> gpuTotal(frames.size(), 0.0);
+    for (const std::string& name : order) {
+        passes.push_back({{"name", name},
+                          {"gpu_ms", summaryJson(gpu[name])},
+                          {"cpu_record_ms", summaryJson(record[name])}});
+    }
+    for (size_t i = 0; i < frames.size(); ++i)
+        for (const vk::PassTime& p : frames[i].passes) gpuTotal[i] += p.gpuMs;
+    return {{"policy", "docs/timing.md: warm-up discarded; median and IQR over timed frames"},
+            {"setup_ms",
+             {{"scene_upload", setup.sceneUploadMs},
+              {"shared_passes", setup.sharedSetupMs},
+              {"technique", setup.techniqueSetupMs},
+              {"total", setup.totalMs}}},
+            {"warmup_frames", warmupFrames},
+            {"timed_frames", frames.size()},
+            {"frame_cpu_ms", summaryJson(cpu)},
+            {"frame_gpu_ms", summaryJson(gpuTotal)},
+            {"passes", passes}};
+}
+
+nlohmann::ordered_json memoryJson(const MemoryReport& memory) {
+    nlohmann::ordered_json owners, tags;
+    for (const auto& [name, bytes] : memory.byOwner) owners[name] = bytes;
+    for (const auto& [name, bytes] : memory.byTag) tags[name] = bytes;
+    return {{"total_bytes", memory.totalBytes},
+            {"peak_bytes", memory.peakBytes},
+            {"by_owner", owners},
+            {"by_resource", tags}};
+}
+
+nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t* nonFinite) {
+    nlohmann::ordered_json out;
+    size_t total = 0;
+    for (const ImageLayer& layer : layers) {
+        const FiniteStats s = countNonFinite(layer.image);
+        out[layer.name] = {{"nan_pixels", s.nanPixels},
+                           {"inf_pixels", s.infPixels},
+                           {"negative_pixels", s.negativePixels}};
+        total += s.nanPixels + s.infPixels;
+    }
+    if (nonFinite) *nonFinite = total;
+    return out;
+}
+
+}  // namespace gilab::cli

@@ -1,0 +1,34 @@
+#pragma once
+/** JSON blocks shared by every output sidecar: provenance, device, scene, timings, memory. */
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/image/image.h"
+#include "core/scene/scene.h"
+#include "core/technique/frame_harness.h"
+
+namespace gilab {
+namespace vk {
+class Context;
+}
+
+namespace cli {
+
+/** git commit, version, compiler, build type, date (UTC, ISO 8601), host, CPU, command line. */
+nlohmann::ordered_json provenanceJson(const std::string& commandLine);
+nlohmann::ordered_json deviceJson(const vk::Context& ctx);
+nlohmann::ordered_json sceneToJson(const Scene& scene);
+/** Setup times, then per-frame CPU and per-pass GPU times as median / IQR over the frames. */
+nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
+                                  int warmupFrames);
+nlohmann::ordered_json memoryJson(const MemoryReport& memory);
+/** {layer: {nan, inf, negative}} and the total non-finite pixel count in `*nonFinite`. */
+nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t* nonFinite);
+std::string isoDateUtc();
+
+Scene loadSceneOrDefault(const std::string& path);
+
+}  // namespace cli
+}  // namespace gilab

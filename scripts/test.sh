@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# README command 2: install, build, and run the whole test suite (ctest). .ci/run calls this.
+set -euo pipefail
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
+"$root/scripts/install_deps.sh"
+"$root/scripts/build.sh"
+cd "$root/build"
+# Lavapipe uses every core per draw; running tests one at a time is faster than in parallel here.
+ctest --output-on-failure --timeout 900
