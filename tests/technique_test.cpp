@@ -57,7 +57,11 @@ Scene smallBox(const std::string& variant = "") {
 
 class GpuHarness : public ::testing::Test {
 protected:
-    void SetUp() override { ctx = std::make_unique<vk::Context>(vk::ContextOptions{true, ""}); }
+    void SetUp() override {
+        vk::ContextOptions options;
+        options.validation = true;
+        ctx = std::make_unique<vk::Context>(options);
+    }
     void TearDown() override {
         for (const std::string& m : ctx->validationMessages()) ADD_FAILURE() << m;
         EXPECT_EQ(ctx->validationErrorCount(), 0u);
@@ -133,7 +137,7 @@ TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
     for (const ImageLayer& l : layers) {
         const FiniteStats s = countNonFinite(l.image);
         EXPECT_TRUE(s.allFinite()) << l.name;
-        EXPECT_EQ(s.negativePixels, 0u) << l.name;
+        if (l.name != "normal") EXPECT_EQ(s.negativePixels, 0u) << l.name;
     }
     const Image& indirect = layer(layers, "indirect").image;
     for (float v : indirect.values()) ASSERT_EQ(v, 0.0f);
@@ -145,10 +149,10 @@ TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
         for (int y = 0; y < emission.height() / 4; ++y) maxLe = std::max(maxLe, emission.at(x, y, 0));
     EXPECT_NEAR(maxLe, 17.0f, 1e-3f);
 
-    // The floor (bottom centre) receives direct light; final = emission + direct + indirect.
+    // The floor left of the short block receives direct light; final = sum of the layers.
     const Image& direct = layer(layers, "direct").image;
     const Image& final = layer(layers, "final").image;
-    const int cx = direct.width() / 2, by = direct.height() - 4;
+    const int cx = direct.width() / 5, by = direct.height() - 2;
     EXPECT_GT(direct.at(cx, by, 0), 0.0f);
     for (int c = 0; c < 3; ++c)
         EXPECT_FLOAT_EQ(final.at(cx, by, c),

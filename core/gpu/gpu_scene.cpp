@@ -31,9 +31,15 @@ GpuLight toGpuLight(const Light& l) {
     GpuLight g{};
     float type = 0.0f;
     switch (l.type) {
-        case LightType::Point: type = float(kLightPoint); break;
-        case LightType::Spot: type = float(kLightSpot); break;
-        case LightType::Directional: type = float(kLightDirectional); break;
+        case LightType::Point:
+            type = float(kLightPoint);
+            break;
+        case LightType::Spot:
+            type = float(kLightSpot);
+            break;
+        case LightType::Directional:
+            type = float(kLightDirectional);
+            break;
     }
     g.positionType = glm::vec4(l.position, type);
     g.directionRange = glm::vec4(l.direction, l.range);
@@ -62,9 +68,8 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene) : m_ctx(&ctx), m_scene(&sce
     for (const Material& m : scene.materials) {
         for (int t : {m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture}) {
             if (t >= int(scene.textures.size())) {
-                throw Error("scene '" + scene.name + "': material '" + m.name +
-                            "' uses texture " + std::to_string(t) + " of " +
-                            std::to_string(scene.textures.size()));
+                throw Error("scene '" + scene.name + "': material '" + m.name + "' uses texture " +
+                            std::to_string(t) + " of " + std::to_string(scene.textures.size()));
             }
         }
     }
@@ -91,18 +96,20 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene) : m_ctx(&ctx), m_scene(&sce
                                  MemoryUsage::DeviceLocal, "scene/triangleMaterials");
     m_triangleMaterials.uploadVector(scene.triangleMaterials);
 
-    for (const Material& m : scene.materials) m_gpuMaterials.push_back(toGpuMaterial(m));
+    for (const Material& m : scene.materials)
+        m_gpuMaterials.push_back(toGpuMaterial(m));
     m_materials = Buffer(ctx, m_gpuMaterials.size() * sizeof(GpuMaterial), kStorage,
                          MemoryUsage::DeviceLocal, "scene/materials");
     m_materials.uploadVector(m_gpuMaterials);
 
-    for (const Light& l : scene.lights) m_gpuLights.push_back(toGpuLight(l));
+    for (const Light& l : scene.lights)
+        m_gpuLights.push_back(toGpuLight(l));
     m_lights = Buffer(ctx, m_gpuLights.size() * sizeof(GpuLight), kStorage,
                       MemoryUsage::DeviceLocal, "scene/lights");
     m_lights.uploadVector(m_gpuLights);
 
-    m_emissiveTriangles = Buffer(ctx, m_emissiveIds.size() * 4, kStorage,
-                                 MemoryUsage::DeviceLocal, "scene/emissiveTriangles");
+    m_emissiveTriangles = Buffer(ctx, m_emissiveIds.size() * 4, kStorage, MemoryUsage::DeviceLocal,
+                                 "scene/emissiveTriangles");
     m_emissiveTriangles.uploadVector(m_emissiveIds);
 
     PackedTextures packed = packTextures(scene.textures);

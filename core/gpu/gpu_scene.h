@@ -27,8 +27,8 @@
 #include <string>
 #include <vector>
 
-#include <glm/glm.hpp>
 #include <vulkan/vulkan.h>
+#include <glm/glm.hpp>
 
 #include "core/scene/scene.h"
 #include "core/vk/buffer.h"

@@ -20,21 +20,27 @@ float linearToSrgb(float c) {
 
 uint32_t wrapCode(WrapMode mode) {
     switch (mode) {
-        case WrapMode::Repeat: return kWrapRepeat;
-        case WrapMode::ClampToEdge: return kWrapClampToEdge;
-        case WrapMode::MirroredRepeat: return kWrapMirroredRepeat;
+        case WrapMode::Repeat:
+            return kWrapRepeat;
+        case WrapMode::ClampToEdge:
+            return kWrapClampToEdge;
+        case WrapMode::MirroredRepeat:
+            return kWrapMirroredRepeat;
     }
     return kWrapRepeat;
 }
 
-uint8_t quantize(float v) { return uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f)); }
+uint8_t quantize(float v) {
+    return uint8_t(std::lround(std::clamp(v, 0.0f, 1.0f) * 255.0f));
+}
 
 }  // namespace
 
 PackedTextures packTextures(const std::vector<Texture>& textures) {
     PackedTextures out;
     float decode[256];
-    for (int i = 0; i < 256; ++i) decode[i] = srgbToLinear(float(i) / 255.0f);
+    for (int i = 0; i < 256; ++i)
+        decode[i] = srgbToLinear(float(i) / 255.0f);
 
     // Entries [0, n) are texture headers; level records follow.
     out.meta.resize(textures.size());
@@ -49,7 +55,8 @@ PackedTextures packTextures(const std::vector<Texture>& textures) {
         bool srgb = tex.colorSpace == ColorSpace::Srgb;
         uint32_t w = uint32_t(tex.width), h = uint32_t(tex.height);
         uint32_t levels = 1;
-        while ((std::max(w, h) >> levels) > 0) ++levels;
+        while ((std::max(w, h) >> levels) > 0)
+            ++levels;
         uint32_t firstLevel = uint32_t(out.meta.size());
         out.meta[t] = glm::uvec4(firstLevel, levels, srgb ? 1u : 0u,
                                  wrapCode(tex.wrapU) | (wrapCode(tex.wrapV) << 4));

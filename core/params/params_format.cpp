@@ -105,11 +105,11 @@ std::string describeParamRange(const ParamSpec& spec) {
 
 std::string formatParamHelp(const std::vector<ParamSpec>& specs) {
     std::vector<std::vector<std::string>> rows;
-    rows.push_back({"name", "type", "default", "range", "unit", "help", "stage"});
+    rows.push_back({"name", "type", "default", "range", "unit", "stage", "help"});
     for (const ParamSpec& spec : specs) {
         rows.push_back({spec.name, paramTypeName(spec.type), spec.defaultValue,
-                        describeParamRange(spec), spec.unit, spec.help,
-                        paramStageName(spec.stage)});
+                        describeParamRange(spec), spec.unit, paramStageName(spec.stage),
+                        spec.help});
     }
     std::vector<size_t> widths(rows[0].size(), 0);
     for (const auto& row : rows) {

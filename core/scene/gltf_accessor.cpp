@@ -57,8 +57,8 @@ double readComponent(const uint8_t* p, int componentType, bool normalized) {
 }
 
 /** Start of the data of `viewIndex` plus `byteOffset`, checking `size` bytes are in bounds. */
-const uint8_t* viewData(const tinygltf::Model& model, int viewIndex, size_t byteOffset,
-                        size_t size, const std::string& what) {
+const uint8_t* viewData(const tinygltf::Model& model, int viewIndex, size_t byteOffset, size_t size,
+                        const std::string& what) {
     if (viewIndex < 0 || size_t(viewIndex) >= model.bufferViews.size()) {
         throw Error(what + ": bufferView " + std::to_string(viewIndex) + " does not exist");
     }
@@ -69,8 +69,8 @@ const uint8_t* viewData(const tinygltf::Model& model, int viewIndex, size_t byte
     const tinygltf::Buffer& buffer = model.buffers[size_t(view.buffer)];
     if (view.byteOffset + view.byteLength > buffer.data.size() ||
         byteOffset + size > view.byteLength) {
-        throw Error(what + ": data runs past the end of bufferView " +
-                    std::to_string(viewIndex) + " or its buffer (truncated .bin?)");
+        throw Error(what + ": data runs past the end of bufferView " + std::to_string(viewIndex) +
+                    " or its buffer (truncated .bin?)");
     }
     return buffer.data.data() + view.byteOffset + byteOffset;
 }
@@ -102,9 +102,9 @@ std::vector<double> readRaw(const tinygltf::Model& model, int index, int compone
         const uint8_t* base = viewData(model, acc.bufferView, acc.byteOffset, span, name);
         for (size_t i = 0; i < acc.count; ++i) {
             for (int c = 0; c < components; ++c) {
-                out[i * size_t(components) + size_t(c)] = readComponent(
-                    base + i * stride + size_t(c) * size_t(compSize), acc.componentType,
-                    acc.normalized);
+                out[i * size_t(components) + size_t(c)] =
+                    readComponent(base + i * stride + size_t(c) * size_t(compSize),
+                                  acc.componentType, acc.normalized);
             }
         }
     }

@@ -22,7 +22,6 @@ std::vector<float> readFloats(const tinygltf::Model& model, int index, int compo
                               const std::string& what);
 
 /** Reads a SCALAR integer accessor as indices; negative values are an error. */
-std::vector<uint32_t> readIndices(const tinygltf::Model& model, int index,
-                                  const std::string& what);
+std::vector<uint32_t> readIndices(const tinygltf::Model& model, int index, const std::string& what);
 
 }  // namespace gilab::gltf

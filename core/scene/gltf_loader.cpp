@@ -8,10 +8,10 @@
 #include <set>
 #include <sstream>
 
+#include <tiny_gltf.h>
 #include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 #include <glm/gtc/quaternion.hpp>
-#include <tiny_gltf.h>
 
 #include "core/scene/gltf_accessor.h"
 #include "core/scene/mesh_builder.h"
@@ -49,7 +49,8 @@ bool hasGlbMagic(const std::string& path) {
 glm::mat4 localTransform(const tinygltf::Node& node) {
     if (node.matrix.size() == 16) {
         glm::mat4 m;
-        for (int i = 0; i < 16; ++i) m[i / 4][i % 4] = float(node.matrix[size_t(i)]);
+        for (int i = 0; i < 16; ++i)
+            m[i / 4][i % 4] = float(node.matrix[size_t(i)]);
         return m;
     }
     glm::mat4 m(1.0f);
@@ -62,21 +63,22 @@ glm::mat4 localTransform(const tinygltf::Node& node) {
         if (glm::length(q) > 0.0f) m = m * glm::mat4_cast(glm::normalize(q));
     }
     if (node.scale.size() == 3) {
-        m = m * glm::scale(glm::mat4(1.0f),
-                           glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
+        m = m * glm::scale(glm::mat4(1.0f), glm::vec3(node.scale[0], node.scale[1], node.scale[2]));
     }
     return m;
 }
 
 std::vector<glm::vec3> toVec3(const std::vector<float>& f) {
     std::vector<glm::vec3> out(f.size() / 3);
-    for (size_t i = 0; i < out.size(); ++i) out[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = {f[3 * i], f[3 * i + 1], f[3 * i + 2]};
     return out;
 }
 
 std::vector<glm::vec2> toVec2(const std::vector<float>& f) {
     std::vector<glm::vec2> out(f.size() / 2);
-    for (size_t i = 0; i < out.size(); ++i) out[i] = {f[2 * i], f[2 * i + 1]};
+    for (size_t i = 0; i < out.size(); ++i)
+        out[i] = {f[2 * i], f[2 * i + 1]};
     return out;
 }
 
@@ -85,7 +87,10 @@ class NodeWalker {
 public:
     NodeWalker(const tinygltf::Model& model, const std::string& file, Scene& scene,
                MaterialConverter& materials)
-        : m_model(model), m_file(file), m_scene(scene), m_materials(materials),
+        : m_model(model),
+          m_file(file),
+          m_scene(scene),
+          m_materials(materials),
           m_onStack(model.nodes.size(), false) {}
 
     void walk(int index, const glm::mat4& parent) {
@@ -103,7 +108,8 @@ public:
         if (auto ext = node.extensions.find("KHR_lights_punctual"); ext != node.extensions.end()) {
             addLight(node, ext->second, world);
         }
-        for (int child : node.children) walk(child, world);
+        for (int child : node.children)
+            walk(child, world);
         m_onStack[size_t(index)] = false;
     }
 
@@ -195,10 +201,14 @@ private:
         Light light;
         light.name = src.name.empty() ? node.name : src.name;
         const std::string what = m_file + ": light '" + light.name + "'";
-        if (src.type == "point") light.type = LightType::Point;
-        else if (src.type == "spot") light.type = LightType::Spot;
-        else if (src.type == "directional") light.type = LightType::Directional;
-        else throw Error(what + " has unknown type '" + src.type + "'");
+        if (src.type == "point")
+            light.type = LightType::Point;
+        else if (src.type == "spot")
+            light.type = LightType::Spot;
+        else if (src.type == "directional")
+            light.type = LightType::Directional;
+        else
+            throw Error(what + " has unknown type '" + src.type + "'");
 
         // Radiometric as-is: intensity x color is W/sr (point, spot) or W/m^2 (directional).
         const glm::vec3 color = src.color.size() == 3
@@ -282,9 +292,15 @@ LoadResult loadFile(const std::string& path) {
     scene.sourcePath = path;
     scene.loadedFiles.push_back(path);
     const fs::path dir = fs::path(path).parent_path();
+    auto isFile = [](const std::string& uri) { return !uri.empty() && uri.rfind("data:", 0) != 0; };
     for (const auto& buffer : model.buffers) {
-        if (!buffer.uri.empty() && buffer.uri.rfind("data:", 0) != 0) {
+        if (isFile(buffer.uri)) {
             scene.loadedFiles.push_back((dir / buffer.uri).lexically_normal().string());
+        }
+    }
+    for (const auto& image : model.images) {  // tinygltf reads every image, used or not
+        if (isFile(image.uri) && !image.image.empty()) {
+            scene.loadedFiles.push_back((dir / image.uri).lexically_normal().string());
         }
     }
     checkExtensions(model, path, scene);
@@ -294,7 +310,8 @@ LoadResult loadFile(const std::string& path) {
     MaterialConverter materials(model, path, scene);
     materials.convertAll();
     NodeWalker walker(model, path, scene, materials);
-    for (int root : rootNodes(model)) walker.walk(root, glm::mat4(1.0f));
+    for (int root : rootNodes(model))
+        walker.walk(root, glm::mat4(1.0f));
     result.hasCamera = walker.hasCamera;
 
     if (walker.stats.degenerateTriangles > 0) {

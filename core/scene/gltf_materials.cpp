@@ -1,6 +1,6 @@
 // glTF materials and textures -> gilab::Material / gilab::Texture.
-#include <algorithm>
 #include <filesystem>
+#include <sstream>
 
 #include <tiny_gltf.h>
 
@@ -13,13 +13,18 @@ namespace {
 
 WrapMode toWrapMode(int wrap) {
     switch (wrap) {
-        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE: return WrapMode::ClampToEdge;
-        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT: return WrapMode::MirroredRepeat;
-        default: return WrapMode::Repeat;
+        case TINYGLTF_TEXTURE_WRAP_CLAMP_TO_EDGE:
+            return WrapMode::ClampToEdge;
+        case TINYGLTF_TEXTURE_WRAP_MIRRORED_REPEAT:
+            return WrapMode::MirroredRepeat;
+        default:
+            return WrapMode::Repeat;
     }
 }
 
-bool isDataUri(const std::string& uri) { return uri.rfind("data:", 0) == 0; }
+bool isDataUri(const std::string& uri) {
+    return uri.rfind("data:", 0) == 0;
+}
 
 /** Decoded tinygltf image (any channel count, 8 or 16 bit) -> RGBA8. */
 std::vector<uint8_t> toRgba8(const tinygltf::Image& image) {
@@ -77,8 +82,7 @@ void MaterialConverter::convertAll() {
             strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
         }
         if (src.emissiveFactor.size() == 3) {
-            mat.emissiveFactor = strength * glm::vec3(src.emissiveFactor[0],
-                                                      src.emissiveFactor[1],
+            mat.emissiveFactor = strength * glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1],
                                                       src.emissiveFactor[2]);
         }
         mat.emissiveTexture = texture(src.emissiveTexture.index, src.emissiveTexture.texCoord,
@@ -91,8 +95,10 @@ void MaterialConverter::convertAll() {
             mat.alphaMode = AlphaMode::Mask;
         } else if (src.alphaMode == "BLEND") {
             mat.alphaMode = AlphaMode::Mask;
-            m_scene.warnings.push_back(m_file + ": " + label + " uses alphaMode BLEND; treated " +
-                                       "as MASK with cutoff " + std::to_string(mat.alphaCutoff));
+            std::ostringstream msg;
+            msg << m_file << ": " << label << " uses alphaMode BLEND; treated as MASK with cutoff "
+                << mat.alphaCutoff;
+            m_scene.warnings.push_back(msg.str());
         }
         if (!warnedMaps && (src.normalTexture.index >= 0 || src.occlusionTexture.index >= 0)) {
             m_scene.warnings.push_back(m_file + ": normal and occlusion textures are ignored");
@@ -160,10 +166,6 @@ int MaterialConverter::texture(int gltfTexture, int texCoord, ColorSpace space,
     out.colorSpace = space;
     out.wrapU = toWrapMode(sampler.wrapS);
     out.wrapV = toWrapMode(sampler.wrapT);
-    auto& files = m_scene.loadedFiles;
-    if (external && std::find(files.begin(), files.end(), imagePath) == files.end()) {
-        files.push_back(imagePath);
-    }
     const int index = int(m_scene.textures.size());
     m_scene.textures.push_back(std::move(out));
     m_textures[key] = index;

@@ -35,10 +35,12 @@ void JsonNode::expectKeys(std::initializer_list<const char*> allowed) const {
     }
     for (const auto& item : m_value->items()) {
         bool known = false;
-        for (const char* key : allowed) known = known || item.key() == key;
+        for (const char* key : allowed)
+            known = known || item.key() == key;
         if (!known) {
             std::string list;
-            for (const char* key : allowed) list += (list.empty() ? "" : ", ") + std::string(key);
+            for (const char* key : allowed)
+                list += (list.empty() ? "" : ", ") + std::string(key);
             throw Error(m_context + ": unknown key \"" + childPath(item.key()) +
                         "\" (allowed here: " + list + ")");
         }
@@ -77,8 +79,8 @@ double JsonNode::number() const {
 double JsonNode::numberIn(double lo, double hi) const {
     const double v = number();
     if (v < lo || v > hi) {
-        fail("out of range: must be in [" + formatNumber(lo) + ", " + formatNumber(hi) +
-             "] (got " + formatNumber(v) + ")");
+        fail("out of range: must be in [" + formatNumber(lo) + ", " + formatNumber(hi) + "] (got " +
+             formatNumber(v) + ")");
     }
     return v;
 }
@@ -119,7 +121,8 @@ glm::vec4 JsonNode::vec4() const {
 glm::vec3 JsonNode::color(double maxValue) const {
     if (arraySize() != 3) fail("expected an RGB array of 3 numbers");
     glm::vec3 c;
-    for (int i = 0; i < 3; ++i) c[i] = float(item(size_t(i)).numberIn(0.0, maxValue));
+    for (int i = 0; i < 3; ++i)
+        c[i] = float(item(size_t(i)).numberIn(0.0, maxValue));
     return c;
 }
 

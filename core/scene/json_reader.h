@@ -33,8 +33,8 @@ public:
     void expectKeys(std::initializer_list<const char*> allowed) const;
     bool has(const char* key) const;
     JsonNode operator[](const char* key) const;  // the key must exist (check has() first)
-    JsonNode item(size_t index) const;  // requires an array with more than `index` items
-    size_t arraySize() const;  // requires an array
+    JsonNode item(size_t index) const;           // requires an array with more than `index` items
+    size_t arraySize() const;                    // requires an array
 
     // Scalars (all check the type; numbers must be finite)
     double number() const;

@@ -12,12 +12,14 @@ namespace {
 bool finite(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }
-bool finite(const glm::vec2& v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+bool finite(const glm::vec2& v) {
+    return std::isfinite(v.x) && std::isfinite(v.y);
+}
 
 template <typename Vec>
 void checkFinite(const std::vector<Vec>& values, const char* attribute, const std::string& what) {
-    const size_t bad = size_t(std::count_if(values.begin(), values.end(),
-                                            [](const Vec& v) { return !finite(v); }));
+    const size_t bad = size_t(
+        std::count_if(values.begin(), values.end(), [](const Vec& v) { return !finite(v); }));
     if (bad > 0) {
         throw Error(what + ": " + std::to_string(bad) + " of " + std::to_string(values.size()) +
                     " " + attribute + " values are NaN or infinite");
@@ -60,14 +62,15 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
     std::vector<uint32_t> indices = prim.indices;
     if (indices.empty()) {
         indices.resize(n);
-        for (size_t i = 0; i < n; ++i) indices[i] = uint32_t(i);
+        for (size_t i = 0; i < n; ++i)
+            indices[i] = uint32_t(i);
     }
     if (indices.size() % 3 != 0) {
         throw Error(what + ": " + std::to_string(indices.size()) +
                     " indices is not a multiple of 3");
     }
-    const size_t outOfRange = size_t(std::count_if(indices.begin(), indices.end(),
-                                                   [n](uint32_t i) { return i >= n; }));
+    const size_t outOfRange =
+        size_t(std::count_if(indices.begin(), indices.end(), [n](uint32_t i) { return i >= n; }));
     if (outOfRange > 0) {
         throw Error(what + ": " + std::to_string(outOfRange) + " indices out of range (" +
                     std::to_string(n) + " vertices)");
@@ -78,7 +81,8 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
     const bool flip = glm::determinant(linear) < 0.0f;
     const glm::mat3 normalMatrix = glm::transpose(glm::inverse(linear));
     std::vector<glm::vec3> positions(n);
-    for (size_t i = 0; i < n; ++i) positions[i] = glm::vec3(toWorld * glm::vec4(prim.positions[i], 1.0f));
+    for (size_t i = 0; i < n; ++i)
+        positions[i] = glm::vec3(toWorld * glm::vec4(prim.positions[i], 1.0f));
 
     // Keep non-degenerate triangles, accumulating area-weighted normals as we go
     std::vector<uint32_t> kept;
@@ -95,7 +99,8 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
             continue;
         }
         kept.insert(kept.end(), {i0, i1, i2});
-        for (uint32_t i : {i0, i1, i2}) smooth[i] += area;
+        for (uint32_t i : {i0, i1, i2})
+            smooth[i] += area;
     }
 
     // Normals: the file's (transformed) where usable, else the smooth face normal
@@ -123,7 +128,8 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
         v.uv = prim.uvs.empty() ? glm::vec2(0.0f) : prim.uvs[i];
         scene.vertices.push_back(v);
     }
-    for (uint32_t i : kept) scene.indices.push_back(base + i);
+    for (uint32_t i : kept)
+        scene.indices.push_back(base + i);
     scene.triangleMaterials.insert(scene.triangleMaterials.end(), kept.size() / 3, material);
 }
 
@@ -137,8 +143,10 @@ void appendQuad(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm:
     }
     const glm::vec2 uvs[4] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {1.0f, 1.0f}, {0.0f, 1.0f}};
     const uint32_t base = uint32_t(scene.vertices.size());
-    for (int i = 0; i < 4; ++i) scene.vertices.push_back(Vertex{corners[i], normal, uvs[i]});
-    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u}) scene.indices.push_back(base + i);
+    for (int i = 0; i < 4; ++i)
+        scene.vertices.push_back(Vertex{corners[i], normal, uvs[i]});
+    for (uint32_t i : {0u, 1u, 2u, 0u, 2u, 3u})
+        scene.indices.push_back(base + i);
     scene.triangleMaterials.insert(scene.triangleMaterials.end(), 2, material);
 }
 

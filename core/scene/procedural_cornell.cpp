@@ -2,10 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <sstream>
 #include <vector>
-
-#include <glm/gtc/constants.hpp>
 
 #include "core/scene/json_reader.h"
 #include "core/scene/mesh_builder.h"
@@ -17,13 +14,15 @@ namespace {
 
 constexpr float kMm = 0.001f;  // the measured data is in millimetres
 
-// Measured block tops (mm), counter-clockwise seen from above; the sides drop to the floor.
-constexpr glm::vec3 kShortBlock[4] = {
-    {130.0f, 165.0f, 65.0f}, {82.0f, 165.0f, 225.0f}, {240.0f, 165.0f, 272.0f},
-    {290.0f, 165.0f, 114.0f}};
-constexpr glm::vec3 kTallBlock[4] = {
-    {423.0f, 330.0f, 247.0f}, {265.0f, 330.0f, 296.0f}, {314.0f, 330.0f, 456.0f},
-    {472.0f, 330.0f, 406.0f}};
+// Measured block tops (mm), in order around the top; the sides drop to the floor.
+constexpr glm::vec3 kShortBlock[4] = {{130.0f, 165.0f, 65.0f},
+                                      {82.0f, 165.0f, 225.0f},
+                                      {240.0f, 165.0f, 272.0f},
+                                      {290.0f, 165.0f, 114.0f}};
+constexpr glm::vec3 kTallBlock[4] = {{423.0f, 330.0f, 247.0f},
+                                     {265.0f, 330.0f, 296.0f},
+                                     {314.0f, 330.0f, 456.0f},
+                                     {472.0f, 330.0f, 406.0f}};
 // Light opening in the ceiling (mm): x in [213, 343], z in [227, 332].
 constexpr glm::vec2 kLightLo{213.0f, 227.0f};
 constexpr glm::vec2 kLightHi{343.0f, 332.0f};
@@ -74,8 +73,7 @@ void addWall(Scene& scene, const glm::vec3& origin, const glm::vec3& u, const gl
             if (!solid(i, j)) continue;
             const float a0 = us[size_t(i)], a1 = us[size_t(i) + 1];
             const float b0 = vs[size_t(j)], b1 = vs[size_t(j) + 1];
-            const glm::vec3 p00 = at(a0, b0), p10 = at(a1, b0), p11 = at(a1, b1),
-                            p01 = at(a0, b1);
+            const glm::vec3 p00 = at(a0, b0), p10 = at(a1, b0), p11 = at(a1, b1), p01 = at(a0, b1);
             appendQuad(scene, p00, p10, p11, p01, inward, material);
             if (thickness <= 0.0f) continue;
             appendQuad(scene, p00 + out, p10 + out, p11 + out, p01 + out, -inward, material);
@@ -135,8 +133,7 @@ void validate(const CornellBoxParams& p) {
     }
     if (p.opening) {
         const glm::vec4 o = *p.opening;
-        if (!(o.x >= 0.0f && o.x < o.z && o.z <= 1.0f && o.y >= 0.0f && o.y < o.w &&
-              o.w <= 1.0f)) {
+        if (!(o.x >= 0.0f && o.x < o.z && o.z <= 1.0f && o.y >= 0.0f && o.y < o.w && o.w <= 1.0f)) {
             invalid("opening must be [u0, v0, u1, v1] with 0 <= u0 < u1 <= 1, 0 <= v0 < v1 <= 1");
         }
     }
@@ -223,7 +220,8 @@ CornellBoxParams cornellBoxParamsFromJson(const JsonNode& node) {
         const JsonNode o = node["opening"];
         if (o.arraySize() != 4) o.fail("expected [u0, v0, u1, v1]");
         glm::vec4 r;
-        for (int i = 0; i < 4; ++i) r[i] = float(o.item(size_t(i)).numberIn(0.0, 1.0));
+        for (int i = 0; i < 4; ++i)
+            r[i] = float(o.item(size_t(i)).numberIn(0.0, 1.0));
         if (!(r.x < r.z && r.y < r.w)) o.fail("need u0 < u1 and v0 < v1");
         p.opening = r;
     }

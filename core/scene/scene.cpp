@@ -13,7 +13,8 @@ void Scene::computeCaps() {
         throw Error(name + ": scene has " + std::to_string(indices.size()) + " indices and " +
                     std::to_string(triangleMaterials.size()) + " triangle materials");
     }
-    for (const Vertex& v : vertices) caps.bounds.extend(v.position);
+    for (const Vertex& v : vertices)
+        caps.bounds.extend(v.position);
 
     // Only materials that some triangle uses count towards the flags.
     std::vector<bool> used(materials.size(), false);

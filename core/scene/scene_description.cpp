@@ -55,7 +55,8 @@ MaterialOverride parseMaterialOverride(const JsonNode& node, const std::string& 
         const size_t n = c.arraySize();
         if (n != 3 && n != 4) c.fail("expected [r, g, b] or [r, g, b, a]");
         glm::vec4 v(1.0f);
-        for (size_t i = 0; i < n; ++i) v[int(i)] = float(c.item(i).numberIn(0.0, 1.0));
+        for (size_t i = 0; i < n; ++i)
+            v[int(i)] = float(c.item(i).numberIn(0.0, 1.0));
         o.baseColor = v;
         o.baseColorHasAlpha = n == 4;
     }
@@ -67,7 +68,8 @@ MaterialOverride parseMaterialOverride(const JsonNode& node, const std::string& 
 
 std::vector<Light> parseLights(const JsonNode& node) {
     std::vector<Light> lights;
-    for (size_t i = 0; i < node.arraySize(); ++i) lights.push_back(parseLight(node.item(i)));
+    for (size_t i = 0; i < node.arraySize(); ++i)
+        lights.push_back(parseLight(node.item(i)));
     return lights;
 }
 
@@ -78,10 +80,14 @@ Light parseLight(const JsonNode& node) {
                      "inner_cone_deg", "outer_cone_deg", "range"});
     Light light;
     const std::string type = node["type"].string();
-    if (type == "point") light.type = LightType::Point;
-    else if (type == "spot") light.type = LightType::Spot;
-    else if (type == "directional") light.type = LightType::Directional;
-    else node["type"].fail("unknown light type \"" + type + "\" (point, spot, directional)");
+    if (type == "point")
+        light.type = LightType::Point;
+    else if (type == "spot")
+        light.type = LightType::Spot;
+    else if (type == "directional")
+        light.type = LightType::Directional;
+    else
+        node["type"].fail("unknown light type \"" + type + "\" (point, spot, directional)");
     light.name = node.has("name") ? node["name"].string() : node.path();
 
     std::optional<glm::vec3> position;
@@ -107,8 +113,11 @@ Light parseLight(const JsonNode& node) {
     if (light.type == LightType::Spot) {
         double outer = 45.0, inner = 0.0;
         if (node.has("outer_cone_deg")) {
-            outer = node["outer_cone_deg"].numberIn(0.0, 90.0);
-            if (!(outer > 0.0)) node["outer_cone_deg"].fail("must be in (0, 90] degrees");
+            const JsonNode key = node["outer_cone_deg"];
+            outer = key.number();
+            if (!(outer > 0.0 && outer <= 90.0)) {
+                key.fail("out of range: must be in (0, 90] degrees (got " + key.raw().dump() + ")");
+            }
         }
         if (node.has("inner_cone_deg")) inner = node["inner_cone_deg"].numberIn(0.0, 90.0);
         if (outer < inner) node.fail("outer_cone_deg must be >= inner_cone_deg");
@@ -123,8 +132,8 @@ Light parseLight(const JsonNode& node) {
 }
 
 SceneDescription parseSceneDescription(const JsonNode& root, const std::string& baseDir) {
-    root.expectKeys({"name", "gltf", "procedural", "camera", "resolution", "exposure_ev",
-                     "lights", "extra_lights", "material_overrides", "remove_emissive"});
+    root.expectKeys({"name", "gltf", "procedural", "camera", "resolution", "exposure_ev", "lights",
+                     "extra_lights", "material_overrides", "remove_emissive"});
     SceneDescription d;
     d.context = root.context();
     if (root.has("name")) {

@@ -34,12 +34,6 @@ nlohmann::json readJson(const std::string& path) {
 }
 
 void applyMaterials(Scene& scene, const SceneDescription& d) {
-    if (d.removeEmissive) {
-        for (Material& m : scene.materials) {
-            m.emissiveFactor = glm::vec3(0.0f);
-            m.emissiveTexture = -1;
-        }
-    }
     for (const MaterialOverride& o : d.materialOverrides) {
         bool found = false;
         for (Material& m : scene.materials) {
@@ -55,9 +49,17 @@ void applyMaterials(Scene& scene, const SceneDescription& d) {
         }
         if (!found) {
             std::string names;
-            for (const Material& m : scene.materials) names += (names.empty() ? "" : ", ") + m.name;
+            for (const Material& m : scene.materials)
+                names += (names.empty() ? "" : ", ") + m.name;
             throw Error(d.context + ": \"material_overrides\": unknown material \"" + o.name +
                         "\" (the scene has: " + names + ")");
+        }
+    }
+    // Last, so it also removes emission an override added.
+    if (d.removeEmissive) {
+        for (Material& m : scene.materials) {
+            m.emissiveFactor = glm::vec3(0.0f);
+            m.emissiveTexture = -1;
         }
     }
 }
@@ -133,7 +135,7 @@ Camera makeFramingCamera(const Bounds& bounds) {
 Scene loadSceneFile(const std::string& pathWithVariant, const std::string& variantArg) {
     // "file.json#variant" or (file.json, variant)
     std::string path = pathWithVariant, variant = variantArg;
-    if (const size_t hash = path.find('#'); hash != std::string::npos) {
+    if (const size_t hash = path.rfind('#'); hash != std::string::npos) {
         const std::string fromPath = path.substr(hash + 1);
         path = path.substr(0, hash);
         if (!variant.empty() && variant != fromPath) {
@@ -166,9 +168,10 @@ Scene loadSceneFile(const std::string& pathWithVariant, const std::string& varia
     auto selected = descriptions.find(variant);
     if (selected == descriptions.end()) {
         std::string names;
-        for (const auto& item : variants.items()) names += (names.empty() ? "" : ", ") + item.key();
-        throw Error(path + ": unknown variant \"" + variant + "\" (available: " +
-                    (names.empty() ? "none" : names) + ")");
+        for (const auto& item : variants.items())
+            names += (names.empty() ? "" : ", ") + item.key();
+        throw Error(path + ": unknown variant \"" + variant +
+                    "\" (available: " + (names.empty() ? "none" : names) + ")");
     }
 
     Scene scene = buildScene(selected->second);

@@ -19,15 +19,20 @@
 
 namespace gilab {
 
+struct SharedPassSettings;
+
 /** Parameters of the shared passes, owner "shared" (set as shared.<key> on the command line). */
 std::vector<ParamSpec> sharedPassParamSpecs();
 ParamSet defaultSharedParams();
+SharedPassSettings sharedSettingsFromParams(const ParamSet& sharedParams);
 
 struct SetupTiming {
     double sceneUploadMs = 0.0;     // CPU wall time: GpuScene creation (buffers, textures)
     double sharedSetupMs = 0.0;     // CPU wall time: shared pass creation (pipelines, images)
+    double shadowMapsMs = 0.0;      // CPU wall time: first render of the (static) shadow maps
     double techniqueSetupMs = 0.0;  // CPU wall time of technique.setup()
     double totalMs = 0.0;
+    std::vector<vk::PassTime> passes;  // GPU times of set-up passes recorded with the timer
 };
 
 struct FrameTiming {
@@ -83,6 +88,7 @@ private:
     std::unique_ptr<vk::GpuTimer> m_timer;
     std::vector<std::string> m_skipped;
     std::vector<std::string> m_notes;
+    std::vector<PassTimeRecord> m_setupTimes;
     bool m_ready = false;
 };
 

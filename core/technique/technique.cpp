@@ -1,6 +1,8 @@
 #include "core/technique/technique.h"
 
 #include "core/scene/scene.h"
+#include "core/vk/context.h"
+#include "core/vk/timer.h"
 
 namespace gilab {
 
@@ -14,6 +16,16 @@ void TechniqueContext::skip(const std::string& pass, const std::string& reason) 
 
 void TechniqueContext::note(const std::string& text) const {
     if (notes) notes->push_back(techniqueId + ": " + text);
+}
+
+void TechniqueContext::submitTimed(const std::function<void(VkCommandBuffer)>& record) const {
+    vk.submitAndWait([&](VkCommandBuffer cmd) {
+        if (timer) timer->reset(cmd);
+        record(cmd);
+    });
+    if (!timer || !setupTimes) return;
+    for (const vk::PassTime& p : timer->resolve())
+        setupTimes->push_back({techniqueId + "/" + p.name, p.gpuMs});
 }
 
 SupportResult Technique::checkSupport(const Scene& scene, const ParamSet&) const {

@@ -16,6 +16,7 @@
  * The harness owns the shared passes (G-buffer, shadow maps, direct light), the composition
  * final = emission + direct + indirect, timing, read-back, NaN/Inf counting and memory reports.
  */
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -68,6 +69,12 @@ struct DebugView {
     vk::Image* image = nullptr;  // RGBA32F at frame resolution, GENERAL or SHADER_READ_ONLY layout
 };
 
+/** A GPU time measured during set-up (see TechniqueContext::submitTimed). */
+struct PassTimeRecord {
+    std::string name;
+    double gpuMs = 0.0;
+};
+
 /** What a technique sees while it sets up and renders. */
 struct TechniqueContext {
     vk::Context& vk;
@@ -85,7 +92,14 @@ struct TechniqueContext {
     std::string tag(const std::string& resource) const;
     void skip(const std::string& pass, const std::string& reason) const;
     void note(const std::string& text) const;
+    /**
+     * For set-up work on the GPU: records with `record` (use ScopedGpuPass with `timer` inside
+     * to name the passes, e.g. "voxelize"), submits and waits; the pass times are added to the
+     * run's set-up timing. Not for use inside render().
+     */
+    void submitTimed(const std::function<void(VkCommandBuffer)>& record) const;
     std::string techniqueId;
+    std::vector<PassTimeRecord>* setupTimes = nullptr;  // internal: filled by submitTimed
 };
 
 /** The images of one frame. `indirect` is cleared to zero before render() is called. */

@@ -31,13 +31,15 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
         VkMemoryPropertyFlags preferred =
             host | (mem == MemoryUsage::Readback ? VK_MEMORY_PROPERTY_HOST_CACHED_BIT
                                                  : VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-        type = ctx.tryFindMemoryType(req.memoryTypeBits, preferred | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+        type = ctx.tryFindMemoryType(req.memoryTypeBits,
+                                     preferred | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
         if (type == UINT32_MAX) type = ctx.tryFindMemoryType(req.memoryTypeBits, preferred);
         if (type == UINT32_MAX) type = ctx.findMemoryType(req.memoryTypeBits, host);
     }
     VkPhysicalDeviceMemoryProperties props;
     vkGetPhysicalDeviceMemoryProperties(ctx.physicalDevice(), &props);
-    m_coherent = (props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
+    m_coherent =
+        (props.memoryTypes[type].propertyFlags & VK_MEMORY_PROPERTY_HOST_COHERENT_BIT) != 0;
 
     VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
@@ -63,9 +65,13 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
     ctx.memory().add(m_name, m_allocSize);
 }
 
-Buffer::~Buffer() { destroy(); }
+Buffer::~Buffer() {
+    destroy();
+}
 
-Buffer::Buffer(Buffer&& other) noexcept { *this = std::move(other); }
+Buffer::Buffer(Buffer&& other) noexcept {
+    *this = std::move(other);
+}
 
 Buffer& Buffer::operator=(Buffer&& other) noexcept {
     if (this != &other) {
@@ -99,8 +105,8 @@ void Buffer::destroy() {
 }
 
 namespace {
-void checkRange(const std::string& name, VkDeviceSize size, VkDeviceSize bytes,
-                VkDeviceSize offset, const char* what) {
+void checkRange(const std::string& name, VkDeviceSize size, VkDeviceSize bytes, VkDeviceSize offset,
+                const char* what) {
     if (offset + bytes > size) {
         throw Error(std::string(what) + " of " + std::to_string(bytes) + " bytes at offset " +
                     std::to_string(offset) + " exceeds buffer '" + name + "' of " +
@@ -124,7 +130,7 @@ void Buffer::upload(const void* data, VkDeviceSize bytes, VkDeviceSize offset) {
         return;
     }
     Buffer staging(*m_ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload,
-                   m_name + ".staging");
+                   "staging/" + m_name);
     staging.upload(data, bytes);
     m_ctx->submitAndWait([&](VkCommandBuffer cmd) {
         VkBufferCopy copy{0, offset, bytes};
@@ -149,7 +155,7 @@ void Buffer::download(void* data, VkDeviceSize bytes, VkDeviceSize offset) {
         return;
     }
     Buffer staging(*m_ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::Readback,
-                   m_name + ".staging");
+                   "staging/" + m_name);
     m_ctx->submitAndWait([&](VkCommandBuffer cmd) {
         VkBufferCopy copy{offset, 0, bytes};
         memoryBarrier(cmd);

@@ -16,10 +16,10 @@ const char* resultName(VkResult result);
 
 }  // namespace gilab::vk
 
-#define VK_CHECK(expr)                                                          \
-    do {                                                                        \
-        VkResult gilabVkResult_ = (expr);                                       \
-        if (gilabVkResult_ != VK_SUCCESS) {                                     \
+#define VK_CHECK(expr)                                                            \
+    do {                                                                          \
+        VkResult gilabVkResult_ = (expr);                                         \
+        if (gilabVkResult_ != VK_SUCCESS) {                                       \
             ::gilab::vk::throwVkError(#expr, gilabVkResult_, __FILE__, __LINE__); \
-        }                                                                       \
+        }                                                                         \
     } while (0)

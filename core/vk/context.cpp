@@ -58,7 +58,8 @@ std::string envString(const char* name) {
 }
 
 std::string lower(std::string s) {
-    for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+    for (char& c : s)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
     return s;
 }
 
@@ -66,8 +67,10 @@ std::string lower(std::string s) {
 
 Context::Context(const ContextOptions& options) {
     std::string envValidation = envString("GILAB_VALIDATION");
-    bool validation = options.validation || (!envValidation.empty() && envValidation != "0");
-    createInstance(validation);
+    bool sync = options.syncValidation || envValidation == "sync";
+    bool validation =
+        options.validation || sync || (!envValidation.empty() && envValidation != "0");
+    createInstance(validation, sync);
     std::string filter = envString("GILAB_DEVICE");
     if (filter.empty()) filter = options.deviceFilter;
     try {
@@ -85,6 +88,13 @@ Context::Context(const ContextOptions& options) {
 }
 
 Context::~Context() {
+    if (m_memory.allocationCount() > 0) {
+        std::string tags;
+        for (const auto& [tag, bytes] : m_memory.byTag())
+            tags += " " + tag;
+        std::fprintf(stderr, "gilab: Context destroyed with %zu live allocations:%s\n",
+                     m_memory.allocationCount(), tags.c_str());
+    }
     if (m_device) {
         vkDeviceWaitIdle(m_device);
         if (m_fence) vkDestroyFence(m_device, m_fence, nullptr);
@@ -99,7 +109,7 @@ Context::~Context() {
     if (m_instance) vkDestroyInstance(m_instance, nullptr);
 }
 
-void Context::createInstance(bool validation) {
+void Context::createInstance(bool validation, bool syncValidation) {
     uint32_t loaderVersion = VK_API_VERSION_1_0;
     vkEnumerateInstanceVersion(&loaderVersion);
     if (loaderVersion < VK_API_VERSION_1_3) {
@@ -135,7 +145,7 @@ void Context::createInstance(bool validation) {
     messengerInfo.pfnUserCallback = debugCallback;
     messengerInfo.pUserData = this;
 
-    // GILAB_VALIDATION=sync additionally turns on synchronization validation (slow).
+    // Synchronization validation (hazards between commands) on request.
     VkValidationFeatureEnableEXT syncFeature =
         VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT;
     VkValidationFeaturesEXT validationFeatures{VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT};
@@ -150,7 +160,7 @@ void Context::createInstance(bool validation) {
     info.ppEnabledExtensionNames = extensions.data();
     if (m_debugUtils) {
         info.pNext = &messengerInfo;
-        if (envString("GILAB_VALIDATION") == "sync") messengerInfo.pNext = &validationFeatures;
+        if (syncValidation) messengerInfo.pNext = &validationFeatures;
     }
     VK_CHECK(vkCreateInstance(&info, nullptr, &m_instance));
 
@@ -184,9 +194,9 @@ void Context::pickDevice(const std::string& filter) {
         DeviceCandidate c;
         c.name = s.name;
         c.type = s.typeName;
-        bool matches = filter.empty() ||
-                       (byIndex ? std::stoul(filter) == i
-                                : lower(s.name).find(lower(filter)) != std::string::npos);
+        bool matches =
+            filter.empty() || (byIndex ? std::stoul(filter) == i
+                                       : lower(s.name).find(lower(filter)) != std::string::npos);
         if (!matches) {
             c.reason = "excluded by device filter '" + filter + "'";
         } else if (!s.missing.empty()) {
@@ -214,7 +224,7 @@ void Context::pickDevice(const std::string& filter) {
         std::string message;
         if (!filter.empty()) {
             message = "no usable Vulkan device matches device filter '" + filter +
-                      "' (GILAB_DEVICE or --device); candidates: " + list();
+                      "' (ContextOptions::deviceFilter or GILAB_DEVICE); candidates: " + list();
         } else {
             message = "no usable Vulkan device: ";
             for (size_t i = 0; i < m_candidates.size(); ++i) {
@@ -266,7 +276,8 @@ void Context::createDevice() {
     queueInfo.pQueuePriorities = &priority;
 
     std::vector<const char*> extensions;
-    for (const auto& e : m_enabledExtensions) extensions.push_back(e.c_str());
+    for (const auto& e : m_enabledExtensions)
+        extensions.push_back(e.c_str());
     VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
     info.pNext = &enabled.features2;
     info.queueCreateInfoCount = 1;
@@ -286,15 +297,25 @@ void Context::createDevice() {
     setDebugName(VK_OBJECT_TYPE_FENCE, uint64_t(m_fence), "context/submitFence");
 }
 
-std::string Context::deviceName() const { return m_properties.deviceName; }
+std::string Context::deviceName() const {
+    return m_properties.deviceName;
+}
 
-std::string Context::deviceType() const { return deviceTypeName(m_properties.deviceType); }
+std::string Context::deviceType() const {
+    return deviceTypeName(m_properties.deviceType);
+}
 
-std::string Context::driverName() const { return m_driverName; }
+std::string Context::driverName() const {
+    return m_driverName;
+}
 
-std::string Context::driverInfo() const { return m_driverInfo; }
+std::string Context::driverInfo() const {
+    return m_driverInfo;
+}
 
-std::string Context::apiVersion() const { return versionString(m_properties.apiVersion); }
+std::string Context::apiVersion() const {
+    return versionString(m_properties.apiVersion);
+}
 
 bool Context::isExtensionEnabled(const std::string& name) const {
     return std::find(m_enabledExtensions.begin(), m_enabledExtensions.end(), name) !=
@@ -394,8 +415,8 @@ uint32_t Context::tryFindMemoryType(uint32_t typeBits, VkMemoryPropertyFlags fla
 uint32_t Context::findMemoryType(uint32_t typeBits, VkMemoryPropertyFlags flags) const {
     uint32_t type = tryFindMemoryType(typeBits, flags);
     if (type == UINT32_MAX) {
-        throw Error("no Vulkan memory type with flags " + std::to_string(flags) +
-                    " in type bits " + std::to_string(typeBits) + " on " + deviceName());
+        throw Error("no Vulkan memory type with flags " + std::to_string(flags) + " in type bits " +
+                    std::to_string(typeBits) + " on " + deviceName());
     }
     return type;
 }

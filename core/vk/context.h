@@ -6,7 +6,7 @@
  * Device selection: discrete > integrated > virtual > CPU (lavapipe), among devices with API 1.3,
  * a graphics+compute queue and every required feature (see docs/vulkan_backend.md). The choice
  * and the reason each device was taken or rejected are in candidates().
- * Env overrides: GILAB_DEVICE (same syntax as deviceFilter), GILAB_VALIDATION=1.
+ * Env overrides: GILAB_DEVICE (same syntax as deviceFilter), GILAB_VALIDATION=1 (or =sync).
  */
 #include <cstdint>
 #include <functional>
@@ -23,6 +23,9 @@ namespace gilab::vk {
 
 struct ContextOptions {
     bool validation = false;
+    /** Also synchronization validation (hazards between commands; slower). Implies validation.
+     *  Env GILAB_VALIDATION=sync turns it on too. */
+    bool syncValidation = false;
     /** "" = auto; else a substring of the device name or a decimal index into the device list. */
     std::string deviceFilter;
 };
@@ -86,7 +89,8 @@ public:
     MemoryTracker& memory() { return m_memory; }
     const MemoryTracker& memory() const { return m_memory; }
 
-    /** Records with `record`, submits on the queue and waits on a fence. Thread-safe (serialised). */
+    /** Records with `record`, submits on the queue and waits on a fence. Thread-safe (serialised).
+     */
     void submitAndWait(const std::function<void(VkCommandBuffer)>& record);
     /** No-op without VK_EXT_debug_utils. */
     void setDebugName(VkObjectType type, uint64_t handle, const std::string& name) const;
@@ -100,7 +104,7 @@ public:
                        VkDebugUtilsMessageTypeFlagsEXT types, const char* message);
 
 private:
-    void createInstance(bool validation);
+    void createInstance(bool validation, bool syncValidation);
     void pickDevice(const std::string& filter);
     void createDevice();
 

@@ -17,7 +17,8 @@ DescriptorSetLayout::DescriptorSetLayout(Context& ctx, std::vector<DescriptorBin
     std::vector<VkDescriptorBindingFlags> flags;
     bool anyFlags = false;
     uint32_t maxBinding = 0;
-    for (const auto& b : m_bindings) maxBinding = std::max(maxBinding, b.binding);
+    for (const auto& b : m_bindings)
+        maxBinding = std::max(maxBinding, b.binding);
     for (const auto& b : m_bindings) {
         VkDescriptorSetLayoutBinding vb{};
         vb.binding = b.binding;
@@ -29,8 +30,10 @@ DescriptorSetLayout::DescriptorSetLayout(Context& ctx, std::vector<DescriptorBin
         if (b.variableCount) {
             if (!ctx.hasDescriptorIndexing()) {
                 throw Error("descriptor set layout '" + name + "': binding " +
-                            std::to_string(b.binding) + " wants a variable descriptor count, "
-                            "but " + ctx.deviceName() + " lacks descriptor indexing");
+                            std::to_string(b.binding) +
+                            " wants a variable descriptor count, "
+                            "but " +
+                            ctx.deviceName() + " lacks descriptor indexing");
             }
             if (b.binding != maxBinding) {
                 throw Error("descriptor set layout '" + name +
@@ -77,7 +80,8 @@ DescriptorSet::DescriptorSet(Context& ctx, const DescriptorSetLayout& layout,
         counts[b.type] += std::max(n, 1u);
     }
     std::vector<VkDescriptorPoolSize> sizes;
-    for (auto [type, n] : counts) sizes.push_back({type, n});
+    for (auto [type, n] : counts)
+        sizes.push_back({type, n});
     if (sizes.empty()) sizes.push_back({VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1});
     VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.maxSets = 1;

@@ -10,11 +10,16 @@ bool DeviceSupport::hasExtension(const std::string& ext) const {
 
 std::string deviceTypeName(VkPhysicalDeviceType type) {
     switch (type) {
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete";
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated";
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual";
-        case VK_PHYSICAL_DEVICE_TYPE_CPU: return "cpu";
-        default: return "other";
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return "discrete";
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return "integrated";
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return "virtual";
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return "cpu";
+        default:
+            return "other";
     }
 }
 
@@ -22,56 +27,61 @@ namespace {
 
 int typeRank(VkPhysicalDeviceType type) {
     switch (type) {
-        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 0;
-        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 1;
-        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
-        case VK_PHYSICAL_DEVICE_TYPE_CPU: return 3;
-        default: return 4;
+        case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:
+            return 0;
+        case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU:
+            return 1;
+        case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:
+            return 2;
+        case VK_PHYSICAL_DEVICE_TYPE_CPU:
+            return 3;
+        default:
+            return 4;
     }
 }
 
 // Required features: (struct, member). Each is checked, reported by name, and enabled.
-#define GILAB_REQUIRED_FEATURES(X)                 \
-    X(core, geometryShader)                        \
-    X(core, fragmentStoresAndAtomics)              \
-    X(core, vertexPipelineStoresAndAtomics)        \
-    X(core, imageCubeArray)                        \
-    X(core, shaderStorageImageWriteWithoutFormat)  \
-    X(core, independentBlend)                      \
-    X(core, depthClamp)                            \
-    X(core, depthBiasClamp)                        \
-    X(v12, scalarBlockLayout)                      \
-    X(v12, hostQueryReset)                         \
-    X(v13, dynamicRendering)                       \
+#define GILAB_REQUIRED_FEATURES(X)                \
+    X(core, geometryShader)                       \
+    X(core, fragmentStoresAndAtomics)             \
+    X(core, vertexPipelineStoresAndAtomics)       \
+    X(core, imageCubeArray)                       \
+    X(core, shaderStorageImageWriteWithoutFormat) \
+    X(core, independentBlend)                     \
+    X(core, depthClamp)                           \
+    X(core, depthBiasClamp)                       \
+    X(v12, scalarBlockLayout)                     \
+    X(v12, hostQueryReset)                        \
+    X(v13, dynamicRendering)                      \
     X(v13, synchronization2)
 
 // Optional features: enabled when present.
-#define GILAB_OPTIONAL_FEATURES(X)                 \
-    X(core, shaderStorageImageReadWithoutFormat)   \
-    X(core, shaderStorageImageExtendedFormats)     \
-    X(core, fillModeNonSolid)                      \
-    X(core, samplerAnisotropy)                     \
-    X(core, multiDrawIndirect)                     \
-    X(core, drawIndirectFirstInstance)             \
-    X(core, shaderInt64)                           \
-    X(core, shaderImageGatherExtended)             \
-    X(core, shaderStorageBufferArrayDynamicIndexing) \
-    X(core, shaderSampledImageArrayDynamicIndexing) \
-    X(core, shaderStorageImageArrayDynamicIndexing) \
-    X(v11, multiview)                              \
-    X(v11, multiviewGeometryShader)                \
-    X(v11, shaderDrawParameters)                   \
-    X(v12, runtimeDescriptorArray)                 \
-    X(v12, shaderSampledImageArrayNonUniformIndexing) \
+#define GILAB_OPTIONAL_FEATURES(X)                     \
+    X(core, shaderStorageImageReadWithoutFormat)       \
+    X(core, shaderStorageImageExtendedFormats)         \
+    X(core, fillModeNonSolid)                          \
+    X(core, samplerAnisotropy)                         \
+    X(core, multiDrawIndirect)                         \
+    X(core, drawIndirectFirstInstance)                 \
+    X(core, shaderInt64)                               \
+    X(core, shaderImageGatherExtended)                 \
+    X(core, shaderStorageBufferArrayDynamicIndexing)   \
+    X(core, shaderSampledImageArrayDynamicIndexing)    \
+    X(core, shaderStorageImageArrayDynamicIndexing)    \
+    X(v11, multiview)                                  \
+    X(v11, multiviewGeometryShader)                    \
+    X(v11, shaderDrawParameters)                       \
+    X(v12, runtimeDescriptorArray)                     \
+    X(v12, shaderSampledImageArrayNonUniformIndexing)  \
     X(v12, shaderStorageBufferArrayNonUniformIndexing) \
-    X(v12, shaderStorageImageArrayNonUniformIndexing) \
-    X(v12, descriptorBindingPartiallyBound)        \
-    X(v12, descriptorBindingVariableDescriptorCount) \
-    X(v12, bufferDeviceAddress)                    \
-    X(v12, timelineSemaphore)                      \
-    X(v12, drawIndirectCount)                      \
-    X(v12, shaderOutputLayer)                      \
-    X(v12, shaderOutputViewportIndex)              \
+    X(v12, shaderStorageImageArrayNonUniformIndexing)  \
+    X(v12, descriptorBindingPartiallyBound)            \
+    X(v12, descriptorBindingVariableDescriptorCount)   \
+    X(v12, bufferDeviceAddress)                        \
+    X(v12, timelineSemaphore)                          \
+    X(v12, drawIndirectCount)                          \
+    X(v12, shaderOutputLayer)                          \
+    X(v12, shaderOutputViewportIndex)                  \
     X(v13, maintenance4)
 
 }  // namespace
@@ -96,7 +106,8 @@ DeviceSupport queryDeviceSupport(VkPhysicalDevice device) {
     vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, nullptr);
     std::vector<VkExtensionProperties> exts(extCount);
     vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, exts.data());
-    for (const auto& e : exts) s.extensions.emplace_back(e.extensionName);
+    for (const auto& e : exts)
+        s.extensions.emplace_back(e.extensionName);
 
     uint32_t familyCount = 0;
     vkGetPhysicalDeviceQueueFamilyProperties(device, &familyCount, nullptr);
@@ -150,10 +161,9 @@ void chooseFeatures(const DeviceSupport& s, EnabledFeatures& out) {
 #undef GILAB_ENABLE_FEATURE
     (void)v11;
     (void)v13;
-    out.descriptorIndexing = v12.runtimeDescriptorArray &&
-                             v12.shaderSampledImageArrayNonUniformIndexing &&
-                             v12.descriptorBindingPartiallyBound &&
-                             v12.descriptorBindingVariableDescriptorCount;
+    out.descriptorIndexing =
+        v12.runtimeDescriptorArray && v12.shaderSampledImageArrayNonUniformIndexing &&
+        v12.descriptorBindingPartiallyBound && v12.descriptorBindingVariableDescriptorCount;
 
     out.features2.pNext = &out.v11;
     out.v11.pNext = &out.v12;

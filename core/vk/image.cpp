@@ -16,31 +16,60 @@ namespace gilab::vk {
 
 uint32_t formatBytesPerTexel(VkFormat format) {
     switch (format) {
-        case VK_FORMAT_R8_UNORM: case VK_FORMAT_R8_SNORM: case VK_FORMAT_R8_UINT:
-        case VK_FORMAT_R8_SINT: case VK_FORMAT_R8_SRGB: case VK_FORMAT_S8_UINT:
+        case VK_FORMAT_R8_UNORM:
+        case VK_FORMAT_R8_SNORM:
+        case VK_FORMAT_R8_UINT:
+        case VK_FORMAT_R8_SINT:
+        case VK_FORMAT_R8_SRGB:
+        case VK_FORMAT_S8_UINT:
             return 1;
-        case VK_FORMAT_R8G8_UNORM: case VK_FORMAT_R8G8_SNORM: case VK_FORMAT_R8G8_UINT:
-        case VK_FORMAT_R16_SFLOAT: case VK_FORMAT_R16_UNORM: case VK_FORMAT_R16_SNORM:
-        case VK_FORMAT_R16_UINT: case VK_FORMAT_R16_SINT: case VK_FORMAT_D16_UNORM:
+        case VK_FORMAT_R8G8_UNORM:
+        case VK_FORMAT_R8G8_SNORM:
+        case VK_FORMAT_R8G8_UINT:
+        case VK_FORMAT_R16_SFLOAT:
+        case VK_FORMAT_R16_UNORM:
+        case VK_FORMAT_R16_SNORM:
+        case VK_FORMAT_R16_UINT:
+        case VK_FORMAT_R16_SINT:
+        case VK_FORMAT_D16_UNORM:
             return 2;
-        case VK_FORMAT_R8G8B8A8_UNORM: case VK_FORMAT_R8G8B8A8_SRGB: case VK_FORMAT_R8G8B8A8_SNORM:
-        case VK_FORMAT_R8G8B8A8_UINT: case VK_FORMAT_R8G8B8A8_SINT: case VK_FORMAT_B8G8R8A8_UNORM:
-        case VK_FORMAT_B8G8R8A8_SRGB: case VK_FORMAT_R16G16_SFLOAT: case VK_FORMAT_R16G16_UNORM:
-        case VK_FORMAT_R16G16_SNORM: case VK_FORMAT_R16G16_UINT: case VK_FORMAT_R32_SFLOAT:
-        case VK_FORMAT_R32_UINT: case VK_FORMAT_R32_SINT: case VK_FORMAT_D32_SFLOAT:
-        case VK_FORMAT_X8_D24_UNORM_PACK32: case VK_FORMAT_D24_UNORM_S8_UINT:
-        case VK_FORMAT_A2B10G10R10_UNORM_PACK32: case VK_FORMAT_A2R10G10B10_UNORM_PACK32:
-        case VK_FORMAT_B10G11R11_UFLOAT_PACK32: case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32:
+        case VK_FORMAT_R8G8B8A8_UNORM:
+        case VK_FORMAT_R8G8B8A8_SRGB:
+        case VK_FORMAT_R8G8B8A8_SNORM:
+        case VK_FORMAT_R8G8B8A8_UINT:
+        case VK_FORMAT_R8G8B8A8_SINT:
+        case VK_FORMAT_B8G8R8A8_UNORM:
+        case VK_FORMAT_B8G8R8A8_SRGB:
+        case VK_FORMAT_R16G16_SFLOAT:
+        case VK_FORMAT_R16G16_UNORM:
+        case VK_FORMAT_R16G16_SNORM:
+        case VK_FORMAT_R16G16_UINT:
+        case VK_FORMAT_R32_SFLOAT:
+        case VK_FORMAT_R32_UINT:
+        case VK_FORMAT_R32_SINT:
+        case VK_FORMAT_D32_SFLOAT:
+        case VK_FORMAT_X8_D24_UNORM_PACK32:
+        case VK_FORMAT_D24_UNORM_S8_UINT:
+        case VK_FORMAT_A2B10G10R10_UNORM_PACK32:
+        case VK_FORMAT_A2R10G10B10_UNORM_PACK32:
+        case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+        case VK_FORMAT_E5B9G9R9_UFLOAT_PACK32:
             return 4;
         case VK_FORMAT_D32_SFLOAT_S8_UINT:
             return 8;
-        case VK_FORMAT_R16G16B16A16_SFLOAT: case VK_FORMAT_R16G16B16A16_UNORM:
-        case VK_FORMAT_R16G16B16A16_SNORM: case VK_FORMAT_R16G16B16A16_UINT:
-        case VK_FORMAT_R32G32_SFLOAT: case VK_FORMAT_R32G32_UINT: case VK_FORMAT_R32G32_SINT:
+        case VK_FORMAT_R16G16B16A16_SFLOAT:
+        case VK_FORMAT_R16G16B16A16_UNORM:
+        case VK_FORMAT_R16G16B16A16_SNORM:
+        case VK_FORMAT_R16G16B16A16_UINT:
+        case VK_FORMAT_R32G32_SFLOAT:
+        case VK_FORMAT_R32G32_UINT:
+        case VK_FORMAT_R32G32_SINT:
             return 8;
-        case VK_FORMAT_R32G32B32_SFLOAT: case VK_FORMAT_R32G32B32_UINT:
+        case VK_FORMAT_R32G32B32_SFLOAT:
+        case VK_FORMAT_R32G32B32_UINT:
             return 12;
-        case VK_FORMAT_R32G32B32A32_SFLOAT: case VK_FORMAT_R32G32B32A32_UINT:
+        case VK_FORMAT_R32G32B32A32_SFLOAT:
+        case VK_FORMAT_R32G32B32A32_UINT:
         case VK_FORMAT_R32G32B32A32_SINT:
             return 16;
         default:
@@ -50,8 +79,11 @@ uint32_t formatBytesPerTexel(VkFormat format) {
 
 bool isDepthFormat(VkFormat format) {
     switch (format) {
-        case VK_FORMAT_D16_UNORM: case VK_FORMAT_D32_SFLOAT: case VK_FORMAT_X8_D24_UNORM_PACK32:
-        case VK_FORMAT_D24_UNORM_S8_UINT: case VK_FORMAT_D32_SFLOAT_S8_UINT:
+        case VK_FORMAT_D16_UNORM:
+        case VK_FORMAT_D32_SFLOAT:
+        case VK_FORMAT_X8_D24_UNORM_PACK32:
+        case VK_FORMAT_D24_UNORM_S8_UINT:
+        case VK_FORMAT_D32_SFLOAT_S8_UINT:
         case VK_FORMAT_D16_UNORM_S8_UINT:
             return true;
         default:
@@ -87,9 +119,15 @@ Image::Image(Context& ctx, const ImageDesc& desc) : m_ctx(&ctx), m_desc(desc) {
     d.layers = std::max(d.layers, 1u);
     uint32_t fullMips = fullMipCount(d.width, d.height, d.depth);
     d.mipLevels = d.mipLevels == 0 ? fullMips : std::min(d.mipLevels, fullMips);
-    if (d.usage == 0) d.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
-    VkImageUsageFlags usage = d.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                              VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    // SAMPLED is always added where the format allows it, so any image can be read by a shader
+    // (and transitioned to SHADER_READ_ONLY_OPTIMAL) without the creator predicting it.
+    VkFormatProperties formatFeatures;
+    vkGetPhysicalDeviceFormatProperties(ctx.physicalDevice(), d.format, &formatFeatures);
+    if (formatFeatures.optimalTilingFeatures & VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT) {
+        d.usage |= VK_IMAGE_USAGE_SAMPLED_BIT;
+    }
+    VkImageUsageFlags usage =
+        d.usage | VK_IMAGE_USAGE_TRANSFER_SRC_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
 
     VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
     info.imageType = d.kind == ImageKind::Image3D ? VK_IMAGE_TYPE_3D : VK_IMAGE_TYPE_2D;
@@ -106,9 +144,9 @@ Image::Image(Context& ctx, const ImageDesc& desc) : m_ctx(&ctx), m_desc(desc) {
         info.flags |= VK_IMAGE_CREATE_CUBE_COMPATIBLE_BIT;
     }
     VkImageFormatProperties formatProps;
-    VkResult supported = vkGetPhysicalDeviceImageFormatProperties(
-        ctx.physicalDevice(), info.format, info.imageType, info.tiling, info.usage, info.flags,
-        &formatProps);
+    VkResult supported =
+        vkGetPhysicalDeviceImageFormatProperties(ctx.physicalDevice(), info.format, info.imageType,
+                                                 info.tiling, info.usage, info.flags, &formatProps);
     if (supported != VK_SUCCESS) {
         throw Error("image '" + d.name + "': format " + std::to_string(int(d.format)) +
                     " with usage 0x" + std::to_string(usage) + " is not supported on " +
@@ -137,18 +175,32 @@ Image::Image(Context& ctx, const ImageDesc& desc) : m_ctx(&ctx), m_desc(desc) {
 
     VkImageViewType type = VK_IMAGE_VIEW_TYPE_2D;
     switch (d.kind) {
-        case ImageKind::Image2D: type = VK_IMAGE_VIEW_TYPE_2D; break;
-        case ImageKind::Image2DArray: type = VK_IMAGE_VIEW_TYPE_2D_ARRAY; break;
-        case ImageKind::Cube: type = VK_IMAGE_VIEW_TYPE_CUBE; break;
-        case ImageKind::CubeArray: type = VK_IMAGE_VIEW_TYPE_CUBE_ARRAY; break;
-        case ImageKind::Image3D: type = VK_IMAGE_VIEW_TYPE_3D; break;
+        case ImageKind::Image2D:
+            type = VK_IMAGE_VIEW_TYPE_2D;
+            break;
+        case ImageKind::Image2DArray:
+            type = VK_IMAGE_VIEW_TYPE_2D_ARRAY;
+            break;
+        case ImageKind::Cube:
+            type = VK_IMAGE_VIEW_TYPE_CUBE;
+            break;
+        case ImageKind::CubeArray:
+            type = VK_IMAGE_VIEW_TYPE_CUBE_ARRAY;
+            break;
+        case ImageKind::Image3D:
+            type = VK_IMAGE_VIEW_TYPE_3D;
+            break;
     }
     m_view = createView(type, 0, d.mipLevels, 0, d.layers, "");
 }
 
-Image::~Image() { destroy(); }
+Image::~Image() {
+    destroy();
+}
 
-Image::Image(Image&& other) noexcept { *this = std::move(other); }
+Image::Image(Image&& other) noexcept {
+    *this = std::move(other);
+}
 
 Image& Image::operator=(Image&& other) noexcept {
     if (this != &other) {
@@ -171,8 +223,10 @@ Image& Image::operator=(Image&& other) noexcept {
 void Image::destroy() {
     if (!m_ctx) return;
     VkDevice device = m_ctx->device();
-    for (auto& [key, view] : m_layerViews) vkDestroyImageView(device, view, nullptr);
-    for (auto& [key, view] : m_mipViews) vkDestroyImageView(device, view, nullptr);
+    for (auto& [key, view] : m_layerViews)
+        vkDestroyImageView(device, view, nullptr);
+    for (auto& [key, view] : m_mipViews)
+        vkDestroyImageView(device, view, nullptr);
     m_layerViews.clear();
     m_mipViews.clear();
     if (m_view) vkDestroyImageView(device, m_view, nullptr);
@@ -284,3 +338,5 @@ void Image::clearDepth(VkCommandBuffer cmd, float depth) {
     vkCmdClearDepthStencilImage(cmd, m_image, VK_IMAGE_LAYOUT_GENERAL, &value, 1, &range);
     memoryBarrier(cmd);
 }
+
+}  // namespace gilab::vk

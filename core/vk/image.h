@@ -34,7 +34,8 @@ uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth = 1);
 class Image {
 public:
     Image() = default;
-    /** TRANSFER_SRC/DST are added to the usage so upload/readback/mips always work. */
+    /** TRANSFER_SRC/DST are added to the usage so upload/readback/mips always work, and SAMPLED
+     *  where the format supports it. */
     Image(Context& ctx, const ImageDesc& desc);
     ~Image();
     Image(const Image&) = delete;
@@ -47,7 +48,8 @@ public:
     VkImageView view() const { return m_view; }
     /** Single-layer 2D view (a cube face, an array layer, or a 3D image's whole slab). Cached. */
     VkImageView layerView(uint32_t layer, uint32_t mip = 0);
-    /** View of one mip over all layers, type matching kind (cube kinds become 2D arrays). Cached. */
+    /** View of one mip over all layers, type matching kind (cube kinds become 2D arrays). Cached.
+     */
     VkImageView mipView(uint32_t mip);
     const ImageDesc& desc() const { return m_desc; }
     uint32_t width() const { return m_desc.width; }

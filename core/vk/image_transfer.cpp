@@ -47,7 +47,7 @@ void Image::upload(Context& ctx, const void* data, size_t bytes, uint32_t layer)
                     std::to_string(expected) + " bytes and a layer < " + std::to_string(d.layers));
     }
     Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, MemoryUsage::Upload,
-                   d.name + ".staging");
+                   "staging/" + d.name);
     staging.upload(data, bytes);
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
         transition(cmd, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL);
@@ -55,8 +55,8 @@ void Image::upload(Context& ctx, const void* data, size_t bytes, uint32_t layer)
         copy.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, layer, 1};
         if (isDepthFormat(d.format)) copy.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
         copy.imageExtent = {d.width, d.height, d.depth};
-        vkCmdCopyBufferToImage(cmd, staging.handle(), m_image,
-                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
+        vkCmdCopyBufferToImage(cmd, staging.handle(), m_image, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               1, &copy);
         transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
     });
 }
@@ -103,8 +103,8 @@ void Image::generateMips(Context& ctx) {
 std::vector<uint8_t> Image::readback(Context& ctx, uint32_t layer, uint32_t mip) {
     const ImageDesc& d = m_desc;
     if (layer >= d.layers || mip >= d.mipLevels) {
-        throw Error("image '" + d.name + "': readback of layer " + std::to_string(layer) +
-                    " mip " + std::to_string(mip) + " out of range");
+        throw Error("image '" + d.name + "': readback of layer " + std::to_string(layer) + " mip " +
+                    std::to_string(mip) + " out of range");
     }
     uint32_t w = std::max(d.width >> mip, 1u);
     uint32_t h = std::max(d.height >> mip, 1u);
@@ -115,17 +115,18 @@ std::vector<uint8_t> Image::readback(Context& ctx, uint32_t layer, uint32_t mip)
     }
     size_t bytes = size_t(w) * h * z * texel;
     Buffer staging(ctx, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, MemoryUsage::Readback,
-                   d.name + ".readback");
+                   "staging/" + d.name + ".readback");
     VkImageLayout previous = m_layout;
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
         transition(cmd, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL);
         VkBufferImageCopy copy{};
-        copy.imageSubresource = {isDepthFormat(d.format) ? VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT)
-                                                         : VkImageAspectFlags(VK_IMAGE_ASPECT_COLOR_BIT),
+        copy.imageSubresource = {isDepthFormat(d.format)
+                                     ? VkImageAspectFlags(VK_IMAGE_ASPECT_DEPTH_BIT)
+                                     : VkImageAspectFlags(VK_IMAGE_ASPECT_COLOR_BIT),
                                  mip, layer, 1};
         copy.imageExtent = {w, h, z};
-        vkCmdCopyImageToBuffer(cmd, m_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                               staging.handle(), 1, &copy);
+        vkCmdCopyImageToBuffer(cmd, m_image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, staging.handle(),
+                               1, &copy);
         hostReadBarrier(cmd);
         // Restore the previous layout (UNDEFINED cannot be a target; keep TRANSFER_SRC then).
         if (previous != VK_IMAGE_LAYOUT_UNDEFINED && previous != VK_IMAGE_LAYOUT_PREINITIALIZED) {
@@ -142,19 +143,29 @@ std::vector<float> Image::readbackFloat(Context& ctx, uint32_t layer, uint32_t m
     VkFormat f = m_desc.format;
     uint32_t channels = 0;
     switch (f) {
-        case VK_FORMAT_R32_SFLOAT: case VK_FORMAT_R16_SFLOAT: case VK_FORMAT_D32_SFLOAT:
-        case VK_FORMAT_R8_UNORM: case VK_FORMAT_R16_UNORM: case VK_FORMAT_D16_UNORM:
+        case VK_FORMAT_R32_SFLOAT:
+        case VK_FORMAT_R16_SFLOAT:
+        case VK_FORMAT_D32_SFLOAT:
+        case VK_FORMAT_R8_UNORM:
+        case VK_FORMAT_R16_UNORM:
+        case VK_FORMAT_D16_UNORM:
             channels = 1;
             break;
-        case VK_FORMAT_R32G32_SFLOAT: case VK_FORMAT_R16G16_SFLOAT: case VK_FORMAT_R8G8_UNORM:
+        case VK_FORMAT_R32G32_SFLOAT:
+        case VK_FORMAT_R16G16_SFLOAT:
+        case VK_FORMAT_R8G8_UNORM:
             channels = 2;
             break;
-        case VK_FORMAT_B10G11R11_UFLOAT_PACK32: case VK_FORMAT_R32G32B32_SFLOAT:
+        case VK_FORMAT_B10G11R11_UFLOAT_PACK32:
+        case VK_FORMAT_R32G32B32_SFLOAT:
             channels = 3;
             break;
-        case VK_FORMAT_R32G32B32A32_SFLOAT: case VK_FORMAT_R16G16B16A16_SFLOAT:
-        case VK_FORMAT_R8G8B8A8_UNORM: case VK_FORMAT_R8G8B8A8_SRGB:
-        case VK_FORMAT_B8G8R8A8_UNORM: case VK_FORMAT_B8G8R8A8_SRGB:
+        case VK_FORMAT_R32G32B32A32_SFLOAT:
+        case VK_FORMAT_R16G16B16A16_SFLOAT:
+        case VK_FORMAT_R8G8B8A8_UNORM:
+        case VK_FORMAT_R8G8B8A8_SRGB:
+        case VK_FORMAT_B8G8R8A8_UNORM:
+        case VK_FORMAT_B8G8R8A8_SRGB:
         case VK_FORMAT_A2B10G10R10_UNORM_PACK32:
             channels = 4;
             break;
@@ -177,19 +188,29 @@ std::vector<float> Image::readbackFloat(Context& ctx, uint32_t layer, uint32_t m
         return v;
     };
     switch (f) {
-        case VK_FORMAT_R32_SFLOAT: case VK_FORMAT_D32_SFLOAT: case VK_FORMAT_R32G32_SFLOAT:
-        case VK_FORMAT_R32G32B32_SFLOAT: case VK_FORMAT_R32G32B32A32_SFLOAT:
+        case VK_FORMAT_R32_SFLOAT:
+        case VK_FORMAT_D32_SFLOAT:
+        case VK_FORMAT_R32G32_SFLOAT:
+        case VK_FORMAT_R32G32B32_SFLOAT:
+        case VK_FORMAT_R32G32B32A32_SFLOAT:
             std::memcpy(out.data(), p, out.size() * sizeof(float));
             break;
-        case VK_FORMAT_R16_SFLOAT: case VK_FORMAT_R16G16_SFLOAT:
+        case VK_FORMAT_R16_SFLOAT:
+        case VK_FORMAT_R16G16_SFLOAT:
         case VK_FORMAT_R16G16B16A16_SFLOAT:
-            for (size_t i = 0; i < out.size(); ++i) out[i] = glm::unpackHalf1x16(u16(i));
+            for (size_t i = 0; i < out.size(); ++i)
+                out[i] = glm::unpackHalf1x16(u16(i));
             break;
-        case VK_FORMAT_R16_UNORM: case VK_FORMAT_D16_UNORM:
-            for (size_t i = 0; i < out.size(); ++i) out[i] = float(u16(i)) / 65535.0f;
+        case VK_FORMAT_R16_UNORM:
+        case VK_FORMAT_D16_UNORM:
+            for (size_t i = 0; i < out.size(); ++i)
+                out[i] = float(u16(i)) / 65535.0f;
             break;
-        case VK_FORMAT_R8_UNORM: case VK_FORMAT_R8G8_UNORM: case VK_FORMAT_R8G8B8A8_UNORM:
-            for (size_t i = 0; i < out.size(); ++i) out[i] = float(p[i]) / 255.0f;
+        case VK_FORMAT_R8_UNORM:
+        case VK_FORMAT_R8G8_UNORM:
+        case VK_FORMAT_R8G8B8A8_UNORM:
+            for (size_t i = 0; i < out.size(); ++i)
+                out[i] = float(p[i]) / 255.0f;
             break;
         case VK_FORMAT_R8G8B8A8_SRGB:
             for (size_t i = 0; i < out.size(); ++i) {
@@ -197,7 +218,8 @@ std::vector<float> Image::readbackFloat(Context& ctx, uint32_t layer, uint32_t m
                 out[i] = (i % 4 == 3) ? v : srgbToLinear(v);
             }
             break;
-        case VK_FORMAT_B8G8R8A8_UNORM: case VK_FORMAT_B8G8R8A8_SRGB:
+        case VK_FORMAT_B8G8R8A8_UNORM:
+        case VK_FORMAT_B8G8R8A8_SRGB:
             for (size_t t = 0; t < texels; ++t) {
                 const uint8_t* q = p + 4 * t;
                 float rgba[4] = {q[2] / 255.0f, q[1] / 255.0f, q[0] / 255.0f, q[3] / 255.0f};

@@ -20,7 +20,7 @@ public:
     VkDeviceSize peak() const;
     /** Live bytes per tag (tags with zero bytes are dropped). */
     std::map<std::string, VkDeviceSize> byTag() const;
-    /** Sum of live bytes of tags starting with `prefix` (e.g. "direct/"). */
+    /** Sum of live bytes of tags starting with `prefix` (e.g. "scene/"). */
     VkDeviceSize totalWithPrefix(const std::string& prefix) const;
     /** Sets peak() to the current total(). */
     void resetPeak();

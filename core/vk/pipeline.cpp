@@ -46,9 +46,13 @@ SpecConstant specFloat(uint32_t id, float value) {
     return {id, bits};
 }
 
-SpecConstant specInt(uint32_t id, int32_t value) { return {id, uint32_t(value)}; }
+SpecConstant specInt(uint32_t id, int32_t value) {
+    return {id, uint32_t(value)};
+}
 
-SpecConstant specBool(uint32_t id, bool value) { return {id, value ? 1u : 0u}; }
+SpecConstant specBool(uint32_t id, bool value) {
+    return {id, value ? 1u : 0u};
+}
 
 namespace {
 
@@ -147,13 +151,15 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
     VkPipelineInputAssemblyStateCreateInfo inputAssembly{
         VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO};
     inputAssembly.topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST;
-    VkPipelineViewportStateCreateInfo viewport{VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
+    VkPipelineViewportStateCreateInfo viewport{
+        VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO};
     viewport.viewportCount = 1;
     viewport.scissorCount = 1;
 
     VkPipelineRasterizationConservativeStateCreateInfoEXT conservative{
         VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_CONSERVATIVE_STATE_CREATE_INFO_EXT};
-    conservative.conservativeRasterizationMode = VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
+    conservative.conservativeRasterizationMode =
+        VK_CONSERVATIVE_RASTERIZATION_MODE_OVERESTIMATE_EXT;
     VkPipelineRasterizationStateCreateInfo raster{
         VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO};
     raster.pNext = desc.conservativeRaster ? &conservative : nullptr;
@@ -188,13 +194,15 @@ GraphicsPipeline::GraphicsPipeline(Context& ctx, const GraphicsPipelineDesc& des
             b.colorBlendOp = b.alphaBlendOp = VK_BLEND_OP_ADD;
         }
     }
-    VkPipelineColorBlendStateCreateInfo blend{VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
+    VkPipelineColorBlendStateCreateInfo blend{
+        VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO};
     blend.attachmentCount = uint32_t(blends.size());
     blend.pAttachments = blends.data();
 
     std::vector<VkDynamicState> dynamic = {VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR};
     if (desc.depthBias) dynamic.push_back(VK_DYNAMIC_STATE_DEPTH_BIAS);
-    VkPipelineDynamicStateCreateInfo dynamicState{VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
+    VkPipelineDynamicStateCreateInfo dynamicState{
+        VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO};
     dynamicState.dynamicStateCount = uint32_t(dynamic.size());
     dynamicState.pDynamicStates = dynamic.data();
 

@@ -71,7 +71,7 @@ struct GraphicsPipelineDesc {
     VkCompareOp depthCompare = VK_COMPARE_OP_LESS;
     VkCullModeFlags cull = VK_CULL_MODE_NONE;
     VkFrontFace frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE;
-    bool depthBias = false;   // dynamic depth bias state (vkCmdSetDepthBias)
+    bool depthBias = false;  // dynamic depth bias state (vkCmdSetDepthBias)
     bool depthClamp = false;
     bool conservativeRaster = false;  // needs VK_EXT_conservative_rasterization, else throws
     bool wireframe = false;           // needs fillModeNonSolid, else throws

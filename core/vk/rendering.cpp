@@ -20,8 +20,8 @@ RenderingScope::RenderingScope(VkCommandBuffer cmd, VkExtent2D extent,
     depthInfo.imageView = depth.view;
     depthInfo.imageLayout = depth.layout;
     depthInfo.loadOp = depth.clear ? VK_ATTACHMENT_LOAD_OP_CLEAR : VK_ATTACHMENT_LOAD_OP_LOAD;
-    depthInfo.storeOp = depth.store ? VK_ATTACHMENT_STORE_OP_STORE
-                                    : VK_ATTACHMENT_STORE_OP_DONT_CARE;
+    depthInfo.storeOp =
+        depth.store ? VK_ATTACHMENT_STORE_OP_STORE : VK_ATTACHMENT_STORE_OP_DONT_CARE;
     if (depth.clear) depthInfo.clearValue.depthStencil = {*depth.clear, 0};
 
     VkRenderingInfo info{VK_STRUCTURE_TYPE_RENDERING_INFO};
@@ -39,6 +39,8 @@ RenderingScope::RenderingScope(VkCommandBuffer cmd, VkExtent2D extent,
     vkCmdSetScissor(cmd, 0, 1, &scissor);
 }
 
-RenderingScope::~RenderingScope() { vkCmdEndRendering(m_cmd); }
+RenderingScope::~RenderingScope() {
+    vkCmdEndRendering(m_cmd);
+}
 
 }  // namespace gilab::vk

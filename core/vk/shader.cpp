@@ -35,9 +35,12 @@ std::span<const uint32_t> findShader(const std::string& name) {
     auto it = r.shaders.find(name);
     if (it != r.shaders.end()) return it->second;
     std::string known;
-    for (const auto& [key, words] : r.shaders) known += (known.empty() ? "" : ", ") + key;
-    throw Error("shader '" + name + "' is not registered (is the file in shaders/ and listed in "
-                "its CMake target?); registered: " + (known.empty() ? "none" : known));
+    for (const auto& [key, words] : r.shaders)
+        known += (known.empty() ? "" : ", ") + key;
+    throw Error("shader '" + name +
+                "' is not registered (is the file in shaders/ and listed in "
+                "its CMake target?); registered: " +
+                (known.empty() ? "none" : known));
 }
 
 bool hasShader(const std::string& name) {
@@ -50,7 +53,8 @@ std::vector<std::string> registeredShaders() {
     Registry& r = registry();
     std::lock_guard lock(r.mutex);
     std::vector<std::string> names;
-    for (const auto& [key, words] : r.shaders) names.push_back(key);
+    for (const auto& [key, words] : r.shaders)
+        names.push_back(key);
     return names;
 }
 

@@ -54,14 +54,15 @@ void GpuTimer::end(VkCommandBuffer cmd) {
         vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, m_pool.handle(),
                              pass.query + 1);
     }
-    pass.cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                          pass.cpuStart)
-                     .count();
+    pass.cpuMs =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - pass.cpuStart)
+            .count();
 }
 
 std::vector<PassTime> GpuTimer::resolve() {
-    if (!m_stack.empty()) throw Error("GpuTimer::resolve with pass '" +
-                                      m_passes[m_stack.back()].name + "' still open");
+    if (!m_stack.empty())
+        throw Error("GpuTimer::resolve with pass '" + m_passes[m_stack.back()].name +
+                    "' still open");
     std::vector<uint64_t> stamps;
     if (m_supported && !m_passes.empty()) {
         stamps.resize(2 * m_passes.size() * 2);  // (value, availability) pairs
@@ -105,6 +106,8 @@ ScopedGpuPass::ScopedGpuPass(GpuTimer& timer, VkCommandBuffer cmd, std::string n
     m_timer.begin(cmd, name);
 }
 
-ScopedGpuPass::~ScopedGpuPass() { m_timer.end(m_cmd); }
+ScopedGpuPass::~ScopedGpuPass() {
+    m_timer.end(m_cmd);
+}
 
 }  // namespace gilab::vk

@@ -142,6 +142,9 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
             record[p.name].push_back(p.cpuRecordMs);
         }
     }
+    nlohmann::ordered_json setupPasses = nlohmann::ordered_json::array();
+    for (const vk::PassTime& p : setup.passes)
+        setupPasses.push_back({{"name", p.name}, {"gpu_ms", number(p.gpuMs)}});
     nlohmann::ordered_json passes = nlohmann::ordered_json::array();
     std::vector<double> gpuTotal(frames.size(), 0.0);
     for (const std::string& name : order) {
@@ -155,8 +158,10 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
             {"setup_ms",
              {{"scene_upload", setup.sceneUploadMs},
               {"shared_passes", setup.sharedSetupMs},
+              {"shadow_maps", setup.shadowMapsMs},
               {"technique", setup.techniqueSetupMs},
               {"total", setup.totalMs}}},
+            {"setup_gpu_passes", setupPasses},
             {"warmup_frames", warmupFrames},
             {"timed_frames", frames.size()},
             {"frame_cpu_ms", summaryJson(cpu)},

@@ -85,7 +85,11 @@ float shadowPcf(int kind, vec2 uv, int layer, float receiverDistance, float bias
 // Visibility in [0, 1] of light `light` from the surface point x with unit normal n (facing
 // the light side the caller shades; wi = unit direction toward the light, dot(n, wi) > 0).
 // Bias, in texels of the map at x (texel = the map's texel footprint at x's distance):
-//   x' = x + n * normalOffset * texel;   lit if stored >= d(x') - (constant + slope*tan) * texel
+//   x' = x + n * normalOffset * (pcfRadius + 1) * texel
+//   lit if stored >= d(x') - (constant + slope * min(tan(theta), 10)) * texel
+// Moving x by h along n gives a margin of h / cos(theta) along the light ray, which grows
+// faster than the tan(theta) * texel per texel that PCF taps see on a tilted receiver, so the
+// normal offset alone keeps grazing receivers free of acne.
 float shadowVisibility(PassLight light, vec3 x, vec3 n, vec3 wi) {
     int kind = int(light.shadow.x);
     if (kind == SHADOW_NONE) return 1.0;
@@ -94,9 +98,9 @@ float shadowVisibility(PassLight light, vec3 x, vec3 n, vec3 wi) {
     float texel = light.shadow.z * dist;
     float cosTheta = clamp(dot(n, wi), 1.0e-4, 1.0);
     float tanTheta = min(sqrt(max(1.0 - cosTheta * cosTheta, 0.0)) / cosTheta, 10.0);
-    float bias = texel * (light.bias.x + light.bias.y * tanTheta);
-    vec3 xo = x + n * (light.bias.z * texel);
     int radius = int(light.bias.w);
+    float bias = texel * (light.bias.x + light.bias.y * tanTheta);
+    vec3 xo = x + n * (light.bias.z * float(radius + 1) * texel);
 
     if (kind == SHADOW_MAP_2D) {
         vec4 clip = light.viewProj * vec4(xo, 1.0);

@@ -1,0 +1,47 @@
+// The shared passes' parameter table (owner "shared"; --set shared.<key>=value).
+#include "core/passes/shared_passes.h"
+#include "core/technique/frame_harness.h"
+
+namespace gilab {
+
+std::vector<ParamSpec> sharedPassParamSpecs() {
+    const ShadowSettings d;
+    const SharedPassSettings s;
+    return {
+        boolParam("shadows", d.enabled, "Shadow maps on (off: every light is unoccluded)",
+                  ParamStage::Rebuild),
+        intParam("shadow_resolution", int(d.resolution), 16, 8192, "texels",
+                 "Side of each 2D shadow map and point-light cube face", ParamStage::Rebuild),
+        intParam("area_shadow_resolution", int(d.areaResolution), 16, 4096, "texels",
+                 "Side of each emitter-sample cube face", ParamStage::Rebuild),
+        intParam("pcf_radius", d.pcfRadius, 0, 8, "texels",
+                 "PCF kernel radius, (2r+1)^2 taps; 0 = hard shadows", ParamStage::Rebuild),
+        floatParam("shadow_constant_bias", d.constantBias, 0.0, 64.0, "texels",
+                   "Constant depth bias", ParamStage::Rebuild),
+        floatParam("shadow_slope_bias", d.slopeBias, 0.0, 64.0, "texels",
+                   "Depth bias per unit tan(angle to the light)", ParamStage::Rebuild),
+        floatParam("shadow_normal_offset", d.normalOffset, 0.0, 64.0, "texels",
+                   "Receiver offset along its normal", ParamStage::Rebuild),
+        intParam("area_light_samples", int(s.areaLightSamples), 0, 4096, "",
+                 "Virtual point lights standing in for emissive surfaces in the direct pass "
+                 "(0 = emitters light nothing directly)",
+                 ParamStage::Rebuild),
+    };
+}
+
+ParamSet defaultSharedParams() { return ParamSet(sharedPassParamSpecs(), "shared"); }
+
+SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
+    SharedPassSettings s;
+    s.shadow.enabled = p.getBool("shadows");
+    s.shadow.resolution = uint32_t(p.getInt("shadow_resolution"));
+    s.shadow.areaResolution = uint32_t(p.getInt("area_shadow_resolution"));
+    s.shadow.pcfRadius = p.getInt("pcf_radius");
+    s.shadow.constantBias = p.getFloat("shadow_constant_bias");
+    s.shadow.slopeBias = p.getFloat("shadow_slope_bias");
+    s.shadow.normalOffset = p.getFloat("shadow_normal_offset");
+    s.areaLightSamples = uint32_t(p.getInt("area_light_samples"));
+    return s;
+}
+
+}  // namespace gilab
