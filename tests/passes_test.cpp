@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include <glm/glm.hpp>
 #include <gtest/gtest.h>
+#include <glm/glm.hpp>
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/emitter_samples.h"
@@ -143,7 +143,9 @@ glm::vec3 measuredIrradiance(const Frame& f, uint32_t x, uint32_t y) {
     return glm::vec3(f.at(f.direct, x, y)) * kPi / kAlbedo;
 }
 
-float relError(float got, float want) { return std::abs(got - want) / std::abs(want); }
+float relError(float got, float want) {
+    return std::abs(got - want) / std::abs(want);
+}
 
 /** Max relative error over the channels where `want` > 0. */
 float relError(glm::vec3 got, glm::vec3 want) {
@@ -240,8 +242,7 @@ TEST_F(GpuPassesTest, GBufferValuesExactAtPixelCentresAndBackgroundZero) {
     float maxPosError = 0.0f;
     for (uint32_t y = 0; y < f.height; ++y) {
         for (uint32_t x = 0; x < f.width; ++x) {
-            Ray ray = cam.primaryRay(float(x) + 0.5f, float(y) + 0.5f, int(f.width),
-                                     int(f.height));
+            Ray ray = cam.primaryRay(float(x) + 0.5f, float(y) + 0.5f, int(f.width), int(f.height));
             glm::vec3 hit = ray.origin + ray.direction * (-ray.origin.y / ray.direction.y);
             glm::vec4 pos = f.at(f.position, x, y);
             bool inside = std::abs(hit.x) < 0.99f && std::abs(hit.z) < 0.99f;
@@ -260,8 +261,8 @@ TEST_F(GpuPassesTest, GBufferValuesExactAtPixelCentresAndBackgroundZero) {
                 EXPECT_EQ(f.at(f.emission, x, y), glm::vec4(0.0f));
             } else if (outside) {
                 ++background;
-                for (const auto* layer : {&f.position, &f.normal, &f.albedo, &f.material,
-                                          &f.emission, &f.direct}) {
+                for (const auto* layer :
+                     {&f.position, &f.normal, &f.albedo, &f.material, &f.emission, &f.direct}) {
                     ASSERT_EQ(f.at(*layer, x, y), glm::vec4(0.0f)) << x << "," << y;
                 }
             }
@@ -359,8 +360,10 @@ TEST_F(GpuPassesTest, SpotLightFollowsConeFalloff) {
             }
         }
     }
-    std::printf("spot: inner %d px max rel %.3g, falloff %d px max rel %.3g, outside %d px max "
-                "%.3g\n", inner, maxInner, falloff, maxFalloff, outside, maxOutside);
+    std::printf(
+        "spot: inner %d px max rel %.3g, falloff %d px max rel %.3g, outside %d px max "
+        "%.3g\n",
+        inner, maxInner, falloff, maxFalloff, outside, maxOutside);
     EXPECT_GE(inner, 16);
     EXPECT_GE(falloff, 16);
     EXPECT_GE(outside, 16);
@@ -442,8 +445,9 @@ TEST_F(GpuPassesTest, NoShadowAcneAtGrazingAngles) {
         }
         glm::vec3 p = light.type == LightType::Directional ? light.direction : light.position;
         std::printf("grazing %s (%.2f, %.2f, %.2f): %d px, max rel error %.3g\n",
-                    light.type == LightType::Point ? "point at"
-                    : light.type == LightType::Spot ? "spot at" : "directional",
+                    light.type == LightType::Point  ? "point at"
+                    : light.type == LightType::Spot ? "spot at"
+                                                    : "directional",
                     p.x, p.y, p.z, checked, maxErr);
         EXPECT_GE(checked, 100);
         EXPECT_LT(maxErr, 0.01f);
@@ -461,8 +465,8 @@ struct OccluderHit {
 };
 
 OccluderHit traceOccluder(const Light& light, glm::vec3 p, float h, glm::vec2 lo, glm::vec2 hi) {
-    glm::vec3 toLight = light.type == LightType::Directional ? -light.direction
-                                                             : light.position - p;
+    glm::vec3 toLight =
+        light.type == LightType::Directional ? -light.direction : light.position - p;
     OccluderHit hit;
     if (toLight.y <= 0.0f) return hit;
     float t = h / toLight.y;
@@ -518,6 +522,30 @@ protected:
     }
 };
 
+TEST_F(GpuShadowTest, AlphaMaskedOccluderIsCutOut) {
+    // Coverage 0.2 below the cutoff 0.5: invisible to the camera and to the light
+    Scene s = planeScene();
+    Material mask = diffuse(glm::vec3(0.5f));
+    mask.baseColorFactor.a = 0.2f;
+    mask.alphaMode = AlphaMode::Mask;
+    s.materials.push_back(mask);
+    addHorizontalQuad(s, 1.0f, glm::vec2(-0.5f), glm::vec2(0.5f), 1.0f, 1);
+    Light light = pointLight({0.0f, 2.0f, 0.0f}, glm::vec3(4.0f));
+    s.lights.push_back(light);
+    Frame f = render(s, topCamera());
+    float maxErr = 0.0f;
+    for (uint32_t y = 0; y < f.height; ++y) {
+        for (uint32_t x = 0; x < f.width; ++x) {
+            ASSERT_TRUE(onPlane(f, x, y));
+            glm::vec3 p(f.at(f.position, x, y));
+            maxErr =
+                std::max(maxErr, relError(measuredIrradiance(f, x, y), pointIrradiance(light, p)));
+        }
+    }
+    std::printf("alpha-masked occluder: max rel error %.3g\n", maxErr);
+    EXPECT_LT(maxErr, 0.01f);
+}
+
 TEST_F(GpuShadowTest, PointLightCubeMap) {
     runOccluder(pointLight({0.05f, 2.0f, 0.0f}, {8.0f, 8.0f, 8.0f}), "point");
 }
@@ -572,12 +600,7 @@ bool segmentHits(const Scene& s, glm::dvec3 o, glm::dvec3 d, double tMin, double
         double v = glm::dot(d, qv) / det;
         if (v < 0.0 || u + v > 1.0) continue;
         double hit = glm::dot(e2, qv) / det;
-        if (hit > tMin && hit < tMax) {
-            if (std::getenv("GILAB_DEBUG_HITS")) {
-                std::printf("    hit tri %zu mat %u at t %.6f of %.6f\n", t, s.triangleMaterials[t], hit, tMax);
-            }
-            return true;
-        }
+        if (hit > tMin && hit < tMax) return true;
     }
     return false;
 }
@@ -610,8 +633,8 @@ glm::vec3 passLightIrradiance(const PassLight& l, glm::vec3 x, glm::vec3& wi, fl
  * points `radius` away in the tangent plane (penumbra, contact and silhouette zones).
  */
 int robustVisibility(const Scene& s, const PassLight& l, glm::vec3 x, glm::vec3 n, float radius) {
-    glm::vec3 t = glm::normalize(glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0)
-                                                                     : glm::vec3(1, 0, 0)));
+    glm::vec3 t = glm::normalize(
+        glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
     glm::vec3 b = glm::cross(n, t);
     int result = -2;
     for (int i = -1; i < 8; ++i) {
@@ -630,11 +653,11 @@ int robustVisibility(const Scene& s, const PassLight& l, glm::vec3 x, glm::vec3 
 
 /** Direct light against ray-cast visibility on the pixels where every light is robust. */
 struct VisibilityStats {
-    int checked = 0;          // robust pixels
-    int withShadow = 0;       // of those, pixels with at least one occluded light
-    int tooDark = 0;          // > 1% below the reference (acne, over-wide shadows)
-    int tooBright = 0;        // > 1% above the reference (leaks, peter-panning)
-    float maxErr = 0.0f;      // max relative error (1 where the reference is 0 and got > 0)
+    int checked = 0;      // robust pixels
+    int withShadow = 0;   // of those, pixels with at least one occluded light
+    int tooDark = 0;      // > 1% below the reference (acne, over-wide shadows)
+    int tooBright = 0;    // > 1% above the reference (leaks, peter-panning)
+    float maxErr = 0.0f;  // max relative error (1 where the reference is 0 and got > 0)
 };
 
 VisibilityStats compareWithRayCast(const Frame& f, const Scene& scene) {
@@ -653,10 +676,12 @@ VisibilityStats compareWithRayCast(const Frame& f, const Scene& scene) {
                 float cosTheta = glm::dot(n, wi);
                 glm::vec3 e = ePerp * cosTheta;
                 if (cosTheta <= 0.0f || e.x + e.y + e.z <= 0.0f) continue;
-                // Shadow edges may move by the PCF footprint and the normal offset (about
-                // 3.5 texels across the light ray): classify only beyond that
+                // Shadow edges may move by the PCF footprint (r + 0.5 texels) and the normal
+                // offset (normalOffset * (r + 1) texels) across the light ray: classify only
+                // beyond that
                 float texel = l.shadow.w > 0.5f ? l.shadow.z : l.shadow.z * dist;
-                float radius = 4.0f * texel / std::max(cosTheta, 0.2f) + 0.002f;
+                float reach = l.bias.w + 0.5f + l.bias.z * (l.bias.w + 1.0f) + 0.5f;
+                float radius = reach * texel / std::max(cosTheta, 0.2f) + 0.002f;
                 int v = robustVisibility(scene, l, p, n, radius);
                 if (v < 0) {
                     robust = false;
@@ -673,8 +698,10 @@ VisibilityStats compareWithRayCast(const Frame& f, const Scene& scene) {
             if (err > 0.01f) {
                 (got.x + got.y + got.z < want.x + want.y + want.z ? st.tooDark : st.tooBright)++;
                 if (std::getenv("GILAB_DEBUG_PASSES")) {
-                    std::printf("  px %u,%u p (%.4f %.4f %.4f) n (%.2f %.2f %.2f) got %.5g "
-                                "want %.5g\n", x, y, p.x, p.y, p.z, n.x, n.y, n.z, got.x, want.x);
+                    std::printf(
+                        "  px %u,%u p (%.4f %.4f %.4f) n (%.2f %.2f %.2f) got %.5g "
+                        "want %.5g\n",
+                        x, y, p.x, p.y, p.z, n.x, n.y, n.z, got.x, want.x);
                 }
             }
             st.maxErr = std::max(st.maxErr, err);
@@ -708,9 +735,10 @@ Scene cornellWithPunctualLights() {
 }
 
 void expectClean(const VisibilityStats& st, const Frame& f, const char* label) {
-    std::printf("cornell %s: %d robust px (%d with a shadowed light), %d too dark, %d too "
-                "bright, max rel error %.3g\n", label, st.checked, st.withShadow, st.tooDark,
-                st.tooBright, st.maxErr);
+    std::printf(
+        "cornell %s: %d robust px (%d with a shadowed light), %d too dark, %d too "
+        "bright, max rel error %.3g\n",
+        label, st.checked, st.withShadow, st.tooDark, st.tooBright, st.maxErr);
     EXPECT_GT(st.checked, int(f.width * f.height / 2));
     EXPECT_GT(st.withShadow, 50);
     EXPECT_LT(st.maxErr, 0.01f);
@@ -746,14 +774,31 @@ TEST_F(GpuShadowTest, DISABLED_BiasSweep) {
                 settings.shadow.normalOffset = normalOffset;
                 settings.shadow.slopeBias = slope;
                 settings.shadow.constantBias = constant;
-                VisibilityStats a = compareWithRayCast(render(punctual, punctual.camera, settings),
-                                                       punctual);
+                VisibilityStats a =
+                    compareWithRayCast(render(punctual, punctual.camera, settings), punctual);
                 VisibilityStats b = compareWithRayCast(render(area, area.camera, settings), area);
-                std::printf("normalOffset %.1f slope %.1f constant %.1f: punctual %d dark %d "
-                            "bright (max %.3g); samples %d dark %d bright (max %.3g)\n",
-                            normalOffset, slope, constant, a.tooDark, a.tooBright, a.maxErr,
-                            b.tooDark, b.tooBright, b.maxErr);
+                std::printf(
+                    "normalOffset %.1f slope %.1f constant %.1f: punctual %d dark %d "
+                    "bright (max %.3g); samples %d dark %d bright (max %.3g)\n",
+                    normalOffset, slope, constant, a.tooDark, a.tooBright, a.maxErr, b.tooDark,
+                    b.tooBright, b.maxErr);
             }
+        }
+    }
+    for (int pcf : {0, 1, 2, 3}) {
+        for (uint32_t res : {256u, 1024u, 2048u}) {
+            SharedPassSettings settings;
+            settings.areaLightSamples = 8;
+            settings.shadow.pcfRadius = pcf;
+            settings.shadow.resolution = res;
+            settings.shadow.areaResolution = res / 4;
+            VisibilityStats a =
+                compareWithRayCast(render(punctual, punctual.camera, settings), punctual);
+            VisibilityStats b = compareWithRayCast(render(area, area.camera, settings), area);
+            std::printf(
+                "defaults, pcfRadius %d resolution %u: punctual %d dark %d bright (max "
+                "%.3g); samples %d dark %d bright (max %.3g)\n",
+                pcf, res, a.tooDark, a.tooBright, a.maxErr, b.tooDark, b.tooBright, b.maxErr);
         }
     }
 }
@@ -842,8 +887,9 @@ TEST_F(GpuPassesTest, GlossyMatchesCpuGltfBrdf) {
         glm::vec3 base;
         float metallic, roughness;
     };
-    for (const Case& c : {Case{{0.8f, 0.6f, 0.3f}, 0.0f, 0.5f}, Case{{0.9f, 0.7f, 0.4f}, 1.0f, 0.3f},
-                          Case{{0.2f, 0.5f, 0.9f}, 0.5f, 0.15f}}) {
+    for (const Case& c :
+         {Case{{0.8f, 0.6f, 0.3f}, 0.0f, 0.5f}, Case{{0.9f, 0.7f, 0.4f}, 1.0f, 0.3f},
+          Case{{0.2f, 0.5f, 0.9f}, 0.5f, 0.15f}}) {
         Scene s = planeScene();
         s.materials[0].baseColorFactor = glm::vec4(c.base, 1.0f);
         s.materials[0].metallic = c.metallic;
@@ -861,15 +907,16 @@ TEST_F(GpuPassesTest, GlossyMatchesCpuGltfBrdf) {
                 glm::vec3 n(0, 1, 0);
                 glm::vec3 l = glm::normalize(light.position - p);
                 glm::vec3 v = glm::normalize(cam.position - p);
-                glm::vec3 want = gltfBrdf(n, l, v, c.base, c.metallic, c.roughness) *
-                                 pointIrradiance(light, p);
+                glm::vec3 want =
+                    gltfBrdf(n, l, v, c.base, c.metallic, c.roughness) * pointIrradiance(light, p);
                 maxErr = std::max(maxErr, relError(glm::vec3(f.at(f.direct, x, y)), want));
                 ++checked;
             }
         }
-        std::printf("glossy base (%.1f %.1f %.1f) metallic %.2f roughness %.2f: %d px, max rel "
-                    "error %.3g\n", c.base.x, c.base.y, c.base.z, c.metallic, c.roughness, checked,
-                    maxErr);
+        std::printf(
+            "glossy base (%.1f %.1f %.1f) metallic %.2f roughness %.2f: %d px, max rel "
+            "error %.3g\n",
+            c.base.x, c.base.y, c.base.z, c.metallic, c.roughness, checked, maxErr);
         EXPECT_GT(checked, 1000);
         EXPECT_LT(maxErr, 1e-3f);
     }
@@ -940,7 +987,8 @@ TEST_F(GpuPassesTest, ShadowMapsRenderedOnceAndReused) {
             passes.record(cmd, topCamera(), &timer);
         });
         std::vector<std::string> names;
-        for (const vk::PassTime& t : timer.resolve()) names.push_back(t.name);
+        for (const vk::PassTime& t : timer.resolve())
+            names.push_back(t.name);
         return names;
     };
     EXPECT_FALSE(passes.shadowsValid());

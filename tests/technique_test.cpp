@@ -46,10 +46,10 @@ GILAB_REGISTER_TECHNIQUE(DummyConstantTechnique)
 namespace {
 
 Scene smallBox(const std::string& variant = "") {
-    Scene scene = variant.empty()
-                      ? makeBuiltinDefaultScene()
-                      : loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json",
-                                      variant);
+    Scene scene =
+        variant.empty()
+            ? makeBuiltinDefaultScene()
+            : loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", variant);
     scene.settings.width = 48;
     scene.settings.height = 48;
     return scene;
@@ -63,7 +63,8 @@ protected:
         ctx = std::make_unique<vk::Context>(options);
     }
     void TearDown() override {
-        for (const std::string& m : ctx->validationMessages()) ADD_FAILURE() << m;
+        for (const std::string& m : ctx->validationMessages())
+            ADD_FAILURE() << m;
         EXPECT_EQ(ctx->validationErrorCount(), 0u);
         EXPECT_EQ(ctx->validationWarningCount(), 0u);
     }
@@ -85,8 +86,8 @@ TEST(CpuRegistry, ListsDirectAndTheDummy) {
     ASSERT_NE(r.find("dummy_constant"), nullptr);
     EXPECT_EQ(r.get("dummy_constant").params.size(), 2u);
     const auto list = r.list();
-    EXPECT_TRUE(std::is_sorted(list.begin(), list.end(),
-                               [](auto* a, auto* b) { return a->id < b->id; }));
+    EXPECT_TRUE(
+        std::is_sorted(list.begin(), list.end(), [](auto* a, auto* b) { return a->id < b->id; }));
 }
 
 TEST(CpuRegistry, UnknownTechniqueNamesTheKnownOnes) {
@@ -112,8 +113,8 @@ TEST(CpuRegistry, DefaultParamsAreValidated) {
 TEST(CpuRegistry, UnsupportedSceneGivesReason) {
     const Scene scene = smallBox("spot");
     auto technique = TechniqueRegistry::instance().create("dummy_constant");
-    const SupportResult s =
-        technique->checkSupport(scene, TechniqueRegistry::instance().defaultParams("dummy_constant"));
+    const SupportResult s = technique->checkSupport(
+        scene, TechniqueRegistry::instance().defaultParams("dummy_constant"));
     EXPECT_FALSE(s.supported);
     EXPECT_NE(s.reason.find("spot"), std::string::npos);
 }
@@ -128,7 +129,8 @@ TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
     const FrameTiming frame = h.renderFrame();
     EXPECT_GT(frame.cpuMs, 0.0);
     std::vector<std::string> names;
-    for (const auto& p : frame.passes) names.push_back(p.name);
+    for (const auto& p : frame.passes)
+        names.push_back(p.name);
     for (const char* expected : {"gbuffer", "direct_light"})
         EXPECT_NE(std::find(names.begin(), names.end(), expected), names.end()) << expected;
 
@@ -137,16 +139,20 @@ TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
     for (const ImageLayer& l : layers) {
         const FiniteStats s = countNonFinite(l.image);
         EXPECT_TRUE(s.allFinite()) << l.name;
-        if (l.name != "normal") EXPECT_EQ(s.negativePixels, 0u) << l.name;
+        if (l.name != "normal") {
+            EXPECT_EQ(s.negativePixels, 0u) << l.name;
+        }
     }
     const Image& indirect = layer(layers, "indirect").image;
-    for (float v : indirect.values()) ASSERT_EQ(v, 0.0f);
+    for (float v : indirect.values())
+        ASSERT_EQ(v, 0.0f);
 
     // The ceiling light is visible near the top centre and shows its radiance exactly.
     const Image& emission = layer(layers, "emission").image;
     float maxLe = 0.0f;
     for (int x = 0; x < emission.width(); ++x)
-        for (int y = 0; y < emission.height() / 4; ++y) maxLe = std::max(maxLe, emission.at(x, y, 0));
+        for (int y = 0; y < emission.height() / 4; ++y)
+            maxLe = std::max(maxLe, emission.at(x, y, 0));
     EXPECT_NEAR(maxLe, 17.0f, 1e-3f);
 
     // The floor left of the short block receives direct light; final = sum of the layers.
@@ -252,6 +258,20 @@ TEST(CpuRender, BadAssignmentNamesTheKey) {
         FAIL() << "expected an error";
     } catch (const Error& e) {
         EXPECT_NE(std::string(e.what()).find("no_such_key"), std::string::npos) << e.what();
+    }
+}
+
+TEST(CpuRender, ShadowMemoryLimitIsCheckedBeforeRendering) {
+    cli::RenderOptions o;
+    o.technique = "direct";
+    o.assignments = {"shared.area_light_samples=4096", "shared.area_shadow_resolution=4096"};
+    o.quiet = true;
+    try {
+        cli::runRender(o);
+        FAIL() << "expected an error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("area_light_samples"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("MiB"), std::string::npos) << e.what();
     }
 }
 

@@ -49,7 +49,8 @@ struct FiniteStats {
 };
 FiniteStats countNonFinite(const Image& image);
 
-/** A named image in a multi-layer file, e.g. {"final", rgb}; channel names follow EXR (R,G,B / Z). */
+/** A named image in a multi-layer file, e.g. {"final", rgb}; channel names follow EXR (R,G,B / Z).
+ */
 struct ImageLayer {
     std::string name;
     Image image;

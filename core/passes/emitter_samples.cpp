@@ -18,7 +18,9 @@ struct EmitterTriangle {
     const Material* material = nullptr;
 };
 
-float luminance(const glm::vec3& c) { return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b; }
+float luminance(const glm::vec3& c) {
+    return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
+}
 
 float srgbToLinear(float c) {
     return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
@@ -26,12 +28,14 @@ float srgbToLinear(float c) {
 
 float wrapCoord(float t, WrapMode mode) {
     switch (mode) {
-    case WrapMode::ClampToEdge: return std::clamp(t, 0.0f, 1.0f);
-    case WrapMode::MirroredRepeat: {
-        float m = t - 2.0f * std::floor(0.5f * t);
-        return m > 1.0f ? 2.0f - m : m;
-    }
-    case WrapMode::Repeat: break;
+        case WrapMode::ClampToEdge:
+            return std::clamp(t, 0.0f, 1.0f);
+        case WrapMode::MirroredRepeat: {
+            float m = t - 2.0f * std::floor(0.5f * t);
+            return m > 1.0f ? 2.0f - m : m;
+        }
+        case WrapMode::Repeat:
+            break;
     }
     return t - std::floor(t);
 }
@@ -93,7 +97,9 @@ std::vector<EmitterTriangle> collectEmitters(const Scene& scene) {
 
 }  // namespace
 
-size_t countEmitterTriangles(const Scene& scene) { return collectEmitters(scene).size(); }
+size_t countEmitterTriangles(const Scene& scene) {
+    return collectEmitters(scene).size();
+}
 
 std::vector<EmitterSample> buildEmitterSamples(const Scene& scene, uint32_t count) {
     std::vector<EmitterTriangle> emitters = collectEmitters(scene);
@@ -101,7 +107,8 @@ std::vector<EmitterSample> buildEmitterSamples(const Scene& scene, uint32_t coun
 
     // Stratify the K samples over the cumulative power: sample k -> share (k + 0.5) / K
     double totalPower = 0.0;
-    for (const EmitterTriangle& e : emitters) totalPower += e.power;
+    for (const EmitterTriangle& e : emitters)
+        totalPower += e.power;
     std::vector<uint32_t> perTriangle(emitters.size(), 0);
     double cumulative = 0.0;
     size_t tri = 0;
@@ -143,7 +150,8 @@ std::vector<EmitterSample> buildEmitterSamples(const Scene& scene, uint32_t coun
 
     // Spread the power of unsampled triangles over all samples
     float scale = sampledPower > 0.0 ? float(totalPower / sampledPower) : 1.0f;
-    for (EmitterSample& s : samples) s.intensity *= scale;
+    for (EmitterSample& s : samples)
+        s.intensity *= scale;
     return samples;
 }
 

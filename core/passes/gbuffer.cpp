@@ -94,7 +94,8 @@ void GBufferPass::record(VkCommandBuffer cmd, const Camera& camera) {
             vkCmdDraw(cmd, 3 * m_scene.triangleCount(), 1, 0, 0);
         }
     }
-    for (vk::Image* layer : layers) layer->transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
+    for (vk::Image* layer : layers)
+        layer->transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
     m_gbuffer.depth.transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
 }
 
@@ -109,8 +110,8 @@ Image computeLinearDepth(const std::vector<float>& positionRgba, uint32_t width,
         for (uint32_t x = 0; x < width; ++x) {
             const float* p = &positionRgba[(size_t(y) * width + x) * 4];
             if (p[3] <= 0.0f) continue;
-            depth.at(int(x), int(y), 0) = glm::dot(glm::vec3(p[0], p[1], p[2]) - camera.position,
-                                                   forward);
+            depth.at(int(x), int(y), 0) =
+                glm::dot(glm::vec3(p[0], p[1], p[2]) - camera.position, forward);
         }
     }
     return depth;

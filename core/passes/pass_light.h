@@ -20,9 +20,9 @@ enum PassLightType : uint32_t {
 
 enum ShadowKind : uint32_t {
     kShadowNone = 0,
-    kShadowMap2D = 1,    // layer of the 2D array (spot, directional)
-    kShadowCube = 2,     // cube of the point cube array (point lights, spots wider than 170 deg)
-    kShadowAreaCube = 3, // cube of the emitter-sample cube array
+    kShadowMap2D = 1,     // layer of the 2D array (spot, directional)
+    kShadowCube = 2,      // cube of the point cube array (point lights, spots with outer > 85 deg)
+    kShadowAreaCube = 3,  // cube of the emitter-sample cube array
 };
 
 struct PassLight {

@@ -13,9 +13,9 @@
 namespace gilab {
 namespace {
 
-constexpr float kNoOccluder = 3.0e38f;      // cleared distance: everything is lit
-constexpr float kSpotMarginRad = 0.0872665f;  // 5 deg added to the spot map's fov
-constexpr float kMaxSpotFovRad = 2.9670597f;  // 170 deg
+constexpr float kNoOccluder = 3.0e38f;           // cleared distance: everything is lit
+constexpr float kSpotMarginRad = 0.0872665f;     // 5 deg added to the spot map's fov
+constexpr float kMaxSpotFovRad = 2.9670597f;     // 170 deg
 constexpr float kCubeSpotOuterRad = 1.4835299f;  // outer cones above 85 deg use a cube
 
 /** Vulkan cube face axes (spec "Cube Map Face Selection"): s, t and the major axis. */
@@ -23,9 +23,9 @@ struct CubeFace {
     glm::vec3 s, t, m;
 };
 constexpr CubeFace kCubeFaces[6] = {
-    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}},  {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
-    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},    {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
-    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},   {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
+    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}}, {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
+    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},   {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
+    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
 };
 
 /**
@@ -141,7 +141,6 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
         ++counter;
     };
 
-    bool wideSpot = false;
     for (const Light& l : scene.lights) {
         PassLight light;
         light.positionType = glm::vec4(l.position, 0.0f);
@@ -156,7 +155,6 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
         } else if (l.type == LightType::Spot) {
             light.positionType.w = float(kPassLightSpot);
             if (shadows && l.outerConeRad > kCubeSpotOuterRad) {
-                wideSpot = true;
                 addCube(light, kShadowCube, m_cubeCount, Job::Push{}, 2.0f / res);
             } else if (shadows) {
                 float fov = std::min(2.0f * l.outerConeRad + kSpotMarginRad, kMaxSpotFovRad);
@@ -175,8 +173,8 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
                 const glm::vec3 origin = center - dir * r;
                 light.origin = glm::vec4(origin, 1.0f);
                 light.viewProj = orthoViewProj(origin, dir, r);
-                light.shadow = glm::vec4(float(kShadowMap2D), float(m_layers2D), 2.0f * r / res,
-                                         1.0f);
+                light.shadow =
+                    glm::vec4(float(kShadowMap2D), float(m_layers2D), 2.0f * r / res, 1.0f);
                 Job job{kShadowMap2D, m_layers2D++, {}};
                 job.push.viewProj = light.viewProj;
                 job.push.origin = glm::vec4(origin, 1.0f);
@@ -220,14 +218,14 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
             m_skipped.push_back("shadow.2d: scene has no spot or directional lights");
         }
         if (m_cubeCount == 0) {
-            m_skipped.push_back("shadow.cube: scene has no point lights (or spots wider than "
-                                "170 deg)");
+            m_skipped.push_back(
+                "shadow.cube: scene has no point lights (or spots with an outer "
+                "cone over 85 deg)");
         }
         if (m_areaCubeCount == 0) {
             m_skipped.push_back("shadow.area_cube: no emitter samples");
         }
     }
-    (void)wideSpot;
 
     // Upload the table and tell the scene's light buffer where each light's map is
     m_lightBuffer = vk::Buffer(m_ctx, std::max<size_t>(m_lights.size(), 1) * sizeof(PassLight),
@@ -245,16 +243,18 @@ void ShadowMaps::createImages() {
     // A 1x1 placeholder stands in for each category the scene lacks
     const uint32_t res = m_settings.resolution;
     const uint32_t areaRes = m_settings.areaResolution;
-    m_maps2D = m_layers2D > 0
-                   ? makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, res, m_layers2D, "maps2d")
-                   : makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, 1, 1, "maps2d_empty");
-    m_cubes = m_cubeCount > 0
-                  ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, res, 6 * m_cubeCount, "cubes")
-                  : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6, "cubes_empty");
-    m_areaCubes = m_areaCubeCount > 0
-                      ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, areaRes,
-                                          6 * m_areaCubeCount, "area_cubes")
-                      : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6, "area_cubes_empty");
+    m_maps2D =
+        m_layers2D > 0
+            ? makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, res, m_layers2D, "maps2d")
+            : makeDistanceImage(m_ctx, vk::ImageKind::Image2DArray, 1, 1, "maps2d_empty");
+    m_cubes =
+        m_cubeCount > 0
+            ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, res, 6 * m_cubeCount, "cubes")
+            : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6, "cubes_empty");
+    m_areaCubes = m_areaCubeCount > 0 ? makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, areaRes,
+                                                          6 * m_areaCubeCount, "area_cubes")
+                                      : makeDistanceImage(m_ctx, vk::ImageKind::CubeArray, 1, 6,
+                                                          "area_cubes_empty");
     if (!m_jobs.empty()) {
         uint32_t depthRes = 0;
         for (const Job& job : m_jobs) {
@@ -289,7 +289,7 @@ void ShadowMaps::record(VkCommandBuffer cmd) {
     for (const Job& job : m_jobs) {
         // The shared depth buffer: full barrier between renders (write after write)
         m_depth.transition(cmd, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
-        vk::Image& target = job.kind == kShadowMap2D ? m_maps2D
+        vk::Image& target = job.kind == kShadowMap2D  ? m_maps2D
                             : job.kind == kShadowCube ? m_cubes
                                                       : m_areaCubes;
         const uint32_t size = target.width();

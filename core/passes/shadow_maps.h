@@ -22,8 +22,8 @@
 #include <string>
 #include <vector>
 
-#include <glm/glm.hpp>
 #include <vulkan/vulkan.h>
+#include <glm/glm.hpp>
 
 #include "core/passes/emitter_samples.h"
 #include "core/passes/pass_light.h"
@@ -99,7 +99,7 @@ private:
         uint32_t layer = 0;  // layer of the target image (6 * cube + face for cubes)
         struct Push {
             glm::mat4 viewProj{1.0f};
-            glm::vec4 origin{0.0f};     // w 1 = orthographic
+            glm::vec4 origin{0.0f};  // w 1 = orthographic
             glm::vec4 direction{0.0f};
             glm::vec4 skipPlane{0.0f};  // emitter plane (normal, offset)
             glm::vec4 params{0.0f};     // x skip-plane half thickness

@@ -12,8 +12,8 @@ SharedPasses::SharedPasses(vk::Context& ctx, vk::GpuScene& scene, uint32_t width
                            const SharedPassSettings& settings)
     : m_width(width), m_height(height), m_settings(settings) {
     m_gbuffer = std::make_unique<GBufferPass>(ctx, scene, width, height);
-    m_shadows = std::make_unique<ShadowMaps>(ctx, scene, settings.shadow,
-                                             settings.areaLightSamples);
+    m_shadows =
+        std::make_unique<ShadowMaps>(ctx, scene, settings.shadow, settings.areaLightSamples);
     m_direct = std::make_unique<DirectLightPass>(ctx, scene, m_gbuffer->images(), *m_shadows);
 }
 
@@ -38,6 +38,8 @@ void SharedPasses::record(VkCommandBuffer cmd, const Camera& camera, vk::GpuTime
     }
 }
 
-std::vector<std::string> SharedPasses::skippedPasses() const { return m_shadows->skippedPasses(); }
+std::vector<std::string> SharedPasses::skippedPasses() const {
+    return m_shadows->skippedPasses();
+}
 
 }  // namespace gilab

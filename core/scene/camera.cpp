@@ -6,11 +6,19 @@
 
 namespace gilab {
 
-glm::vec3 Camera::forward() const { return glm::normalize(target - position); }
-glm::vec3 Camera::right() const { return glm::normalize(glm::cross(forward(), up)); }
-glm::vec3 Camera::trueUp() const { return glm::cross(right(), forward()); }
+glm::vec3 Camera::forward() const {
+    return glm::normalize(target - position);
+}
+glm::vec3 Camera::right() const {
+    return glm::normalize(glm::cross(forward(), up));
+}
+glm::vec3 Camera::trueUp() const {
+    return glm::cross(right(), forward());
+}
 
-glm::mat4 Camera::view() const { return glm::lookAtRH(position, target, up); }
+glm::mat4 Camera::view() const {
+    return glm::lookAtRH(position, target, up);
+}
 
 glm::mat4 Camera::projection(float aspect) const {
     glm::mat4 p = glm::perspectiveRH_ZO(vfovRad, aspect, nearZ, farZ);

@@ -60,7 +60,7 @@ enum class AlphaMode { Opaque, Mask, Blend };
 struct Material {
     std::string name;
     glm::vec4 baseColorFactor{1.0f};  // rgb = albedo, a = coverage
-    int baseColorTexture = -1;         // index into Scene::textures (sRGB)
+    int baseColorTexture = -1;        // index into Scene::textures (sRGB)
     float metallic = 0.0f;
     float roughness = 1.0f;             // perceptual roughness; GGX alpha = roughness^2
     int metallicRoughnessTexture = -1;  // linear; G = roughness, B = metallic
@@ -89,7 +89,8 @@ struct Light {
     std::string name;
     LightType type = LightType::Point;
     glm::vec3 position{0.0f};
-    glm::vec3 direction{0.0f, -1.0f, 0.0f};  // unit; the direction light travels (spot, directional)
+    glm::vec3 direction{0.0f, -1.0f,
+                        0.0f};  // unit; the direction light travels (spot, directional)
     glm::vec3 intensity{1.0f};
     float innerConeRad = 0.0f;  // spot only
     float outerConeRad = 0.7853982f;

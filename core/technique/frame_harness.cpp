@@ -61,7 +61,9 @@ FrameHarness::FrameHarness(vk::Context& ctx, const Scene& scene, const std::stri
 
 FrameHarness::~FrameHarness() = default;
 
-const TechniqueInfo& FrameHarness::info() const { return m_technique->info(); }
+const TechniqueInfo& FrameHarness::info() const {
+    return m_technique->info();
+}
 
 TechniqueContext FrameHarness::makeContext() {
     TechniqueContext ctx{m_ctx,
@@ -94,7 +96,8 @@ SetupTiming FrameHarness::setup() {
     sw.restart();
     m_shared = std::make_unique<SharedPasses>(m_ctx, *m_gpuScene, w, h,
                                               sharedSettingsFromParams(m_sharedParams));
-    for (const std::string& s : m_shared->skippedPasses()) m_skipped.push_back("shared/" + s);
+    for (const std::string& s : m_shared->skippedPasses())
+        m_skipped.push_back("shared/" + s);
     m_indirect = makeFrameImage(m_ctx, w, h, "shared/frame.indirect");
     m_timer = std::make_unique<vk::GpuTimer>(m_ctx, 128);
     t.sharedSetupMs = sw.elapsedMs();
@@ -113,7 +116,8 @@ SetupTiming FrameHarness::setup() {
     TechniqueContext ctx = makeContext();
     m_technique->setup(ctx);
     t.techniqueSetupMs = sw.elapsedMs();
-    for (const PassTimeRecord& p : m_setupTimes) t.passes.push_back({p.name, p.gpuMs, 0.0});
+    for (const PassTimeRecord& p : m_setupTimes)
+        t.passes.push_back({p.name, p.gpuMs, 0.0});
     t.totalMs = total.elapsedMs();
     m_ready = true;
     return t;
@@ -160,14 +164,8 @@ std::vector<ImageLayer> FrameHarness::readLayers() {
         final.values()[i] = emission.values()[i] + direct.values()[i] + indirect.values()[i];
 
     // Depth = distance along the camera's forward axis; 0 where there is no geometry.
-    Image depth(position.width(), position.height(), 1);
-    const glm::vec3 eye = m_scene.camera.position, forward = m_scene.camera.forward();
-    for (int y = 0; y < depth.height(); ++y)
-        for (int x = 0; x < depth.width(); ++x) {
-            if (position.at(x, y, 3) <= 0.0f) continue;
-            const glm::vec3 p{position.at(x, y, 0), position.at(x, y, 1), position.at(x, y, 2)};
-            depth.at(x, y, 0) = glm::dot(p - eye, forward);
-        }
+    Image depth = computeLinearDepth(position.values(), uint32_t(position.width()),
+                                     uint32_t(position.height()), m_scene.camera);
 
     std::vector<ImageLayer> layers;
     layers.push_back({"final", std::move(final)});

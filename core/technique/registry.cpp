@@ -24,7 +24,8 @@ std::vector<const TechniqueInfo*> TechniqueRegistry::list() const {
         throw Error("technique id registered twice: " + m_duplicates.front() +
                     " (each techniques/<id>/ folder must have a unique id)");
     std::vector<const TechniqueInfo*> out;
-    for (const Entry& e : m_entries) out.push_back(&e.info);
+    for (const Entry& e : m_entries)
+        out.push_back(&e.info);
     std::sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->id < b->id; });
     return out;
 }
@@ -38,7 +39,8 @@ const TechniqueInfo* TechniqueRegistry::find(const std::string& id) const {
 const TechniqueInfo& TechniqueRegistry::get(const std::string& id) const {
     if (const TechniqueInfo* info = find(id)) return *info;
     std::string known;
-    for (const TechniqueInfo* info : list()) known += (known.empty() ? "" : ", ") + info->id;
+    for (const TechniqueInfo* info : list())
+        known += (known.empty() ? "" : ", ") + info->id;
     throw Error("unknown technique \"" + id + "\" (known: " + known + ")");
 }
 

@@ -49,7 +49,7 @@ struct TechniqueRegistrar {
 }  // namespace gilab
 
 #define GILAB_REGISTER_TECHNIQUE(Class)                                                      \
-    namespace {                                                                               \
-    const ::gilab::TechniqueRegistrar kGilabRegistrar_##Class{                                \
+    namespace {                                                                              \
+    const ::gilab::TechniqueRegistrar kGilabRegistrar_##Class{                               \
         Class::describe(), [] { return std::unique_ptr<::gilab::Technique>(new Class()); }}; \
     }

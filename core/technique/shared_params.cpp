@@ -1,6 +1,7 @@
 // The shared passes' parameter table (owner "shared"; --set shared.<key>=value).
 #include "core/passes/shared_passes.h"
 #include "core/technique/frame_harness.h"
+#include "core/util/error.h"
 
 namespace gilab {
 
@@ -21,7 +22,8 @@ std::vector<ParamSpec> sharedPassParamSpecs() {
         floatParam("shadow_slope_bias", d.slopeBias, 0.0, 64.0, "texels",
                    "Depth bias per unit tan(angle to the light)", ParamStage::Rebuild),
         floatParam("shadow_normal_offset", d.normalOffset, 0.0, 64.0, "texels",
-                   "Receiver offset along its normal", ParamStage::Rebuild),
+                   "Receiver offset along its normal, in texels per (pcf_radius + 1)",
+                   ParamStage::Rebuild),
         intParam("area_light_samples", int(s.areaLightSamples), 0, 4096, "",
                  "Virtual point lights standing in for emissive surfaces in the direct pass "
                  "(0 = emitters light nothing directly)",
@@ -29,7 +31,14 @@ std::vector<ParamSpec> sharedPassParamSpecs() {
     };
 }
 
-ParamSet defaultSharedParams() { return ParamSet(sharedPassParamSpecs(), "shared"); }
+namespace {
+// Emitter-sample cubes: K cubes x 6 faces x res^2 x (R32F distance + D32 depth).
+constexpr double kMaxAreaShadowBytes = 4.0 * 1024 * 1024 * 1024;
+}  // namespace
+
+ParamSet defaultSharedParams() {
+    return ParamSet(sharedPassParamSpecs(), "shared");
+}
 
 SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
     SharedPassSettings s;
@@ -41,6 +50,14 @@ SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
     s.shadow.slopeBias = p.getFloat("shadow_slope_bias");
     s.shadow.normalOffset = p.getFloat("shadow_normal_offset");
     s.areaLightSamples = uint32_t(p.getInt("area_light_samples"));
+    const double res = double(s.shadow.areaResolution);
+    const double bytes = double(s.areaLightSamples) * 6.0 * res * res * 8.0;
+    if (s.shadow.enabled && bytes > kMaxAreaShadowBytes)
+        throw Error(
+            "shared.area_light_samples=" + std::to_string(s.areaLightSamples) +
+            " with shared.area_shadow_resolution=" + std::to_string(s.shadow.areaResolution) +
+            " needs " + std::to_string(int(bytes / (1024.0 * 1024.0))) +
+            " MiB of shadow cubes (limit 4096 MiB); lower one of them");
     return s;
 }
 

@@ -16,7 +16,9 @@ double seconds(std::chrono::steady_clock::duration d) {
 }
 }  // namespace
 
-void Progress::setQuiet(bool quiet) { g_quiet = quiet; }
+void Progress::setQuiet(bool quiet) {
+    g_quiet = quiet;
+}
 
 Progress::Progress(std::string label, size_t total)
     : m_label(std::move(label)),

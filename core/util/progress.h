@@ -35,8 +35,7 @@ class Stopwatch {
 public:
     Stopwatch() : m_start(std::chrono::steady_clock::now()) {}
     double elapsedMs() const {
-        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() -
-                                                         m_start)
+        return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - m_start)
             .count();
     }
     void restart() { m_start = std::chrono::steady_clock::now(); }

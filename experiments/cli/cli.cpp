@@ -16,7 +16,8 @@ int runMain(int argc, char** argv) {
     app.set_help_all_flag("--help-all", "Help for every command");
 
     std::string commandLine;
-    for (int i = 0; i < argc; ++i) commandLine += (i ? " " : "") + std::string(argv[i]);
+    for (int i = 0; i < argc; ++i)
+        commandLine += (i ? " " : "") + std::string(argv[i]);
 
     bool listJson = false;
     CLI::App* list = app.add_subcommand("list", "List techniques and their parameters");
@@ -37,8 +38,9 @@ int runMain(int argc, char** argv) {
     render.commandLine = commandLine;
     CLI::App* rend = app.add_subcommand(
         "render", "Render one technique on one scene: EXR layers, PNG preview, JSON sidecar");
-    rend->add_option("--scene", render.scenePath,
-                     "Scene description (.json, optionally #variant); default: built-in Cornell box");
+    rend->add_option(
+        "--scene", render.scenePath,
+        "Scene description (.json, optionally #variant); default: built-in Cornell box");
     rend->add_option("--technique,-t", render.technique, "Technique id (see `gilab list`)")
         ->capture_default_str();
     rend->add_option("--set", render.assignments,

@@ -17,8 +17,8 @@ int runDevices(const std::string& device) {
     for (const vk::DeviceCandidate& c : ctx.candidates())
         std::printf("%s %-40s %-10s %s\n", c.chosen ? "*" : " ", c.name.c_str(), c.type.c_str(),
                     c.reason.c_str());
-    std::printf("driver: %s (%s), Vulkan %s\n", ctx.driverName().c_str(),
-                ctx.driverInfo().c_str(), ctx.apiVersion().c_str());
+    std::printf("driver: %s (%s), Vulkan %s\n", ctx.driverName().c_str(), ctx.driverInfo().c_str(),
+                ctx.apiVersion().c_str());
     return kExitOk;
 }
 
@@ -38,12 +38,13 @@ int runSceneInfo(const std::string& scenePath, bool json) {
     std::printf("  %zu triangles (%zu emissive), %zu materials, %zu textures, %zu lights\n",
                 c.triangleCount, c.emissiveTriangleCount, scene.materials.size(),
                 scene.textures.size(), scene.lights.size());
-    std::printf("  bounds [%g %g %g] .. [%g %g %g]\n", c.bounds.lo.x, c.bounds.lo.y,
-                c.bounds.lo.z, c.bounds.hi.x, c.bounds.hi.y, c.bounds.hi.z);
+    std::printf("  bounds [%g %g %g] .. [%g %g %g]\n", c.bounds.lo.x, c.bounds.lo.y, c.bounds.lo.z,
+                c.bounds.hi.x, c.bounds.hi.y, c.bounds.hi.z);
     std::printf("  features: %s\n", info["caps"]["features"].dump().c_str());
     std::printf("  resolution %dx%d, exposure %+g EV\n", scene.settings.width,
                 scene.settings.height, scene.settings.exposureEv);
-    for (const std::string& w : scene.warnings) std::printf("  warning: %s\n", w.c_str());
+    for (const std::string& w : scene.warnings)
+        std::printf("  warning: %s\n", w.c_str());
     return kExitOk;
 }
 

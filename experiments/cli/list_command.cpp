@@ -70,11 +70,13 @@ int runList(bool json) {
         if (t->params.empty())
             std::printf("  parameters: none of its own (the shared passes' apply)\n\n");
         else
-            std::printf("  parameters (--set key=value):\n%s\n", formatParamHelp(t->params).c_str());
+            std::printf("  parameters (--set key=value):\n%s\n",
+                        formatParamHelp(t->params).c_str());
     }
-    std::printf("shared passes (G-buffer, shadow maps, direct light; every technique) — "
-                "--set shared.key=value:\n%s",
-                formatParamHelp(shared).c_str());
+    std::printf(
+        "shared passes (G-buffer, shadow maps, direct light; every technique) — "
+        "--set shared.key=value:\n%s",
+        formatParamHelp(shared).c_str());
     return kExitOk;
 }
 

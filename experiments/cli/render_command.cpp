@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "core/image/image_io.h"
+#include "core/passes/shared_passes.h"
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
 #include "core/technique/registry.h"
@@ -66,6 +67,7 @@ int runRender(const RenderOptions& options) {
     ParamSet params = registry.defaultParams(options.technique);
     ParamSet shared = defaultSharedParams();
     applyAssignments(options.assignments, params, shared);
+    (void)sharedSettingsFromParams(shared);  // cross-parameter limits, before any GPU work
 
     vk::ContextOptions ctxOptions;
     ctxOptions.validation = options.validation;
@@ -131,19 +133,22 @@ int runRender(const RenderOptions& options) {
 
     const auto& cpu = meta["timing"]["frame_cpu_ms"];
     const auto& gpu = meta["timing"]["frame_gpu_ms"];
-    std::printf("%s on %s (%dx%d, %s): set-up %.1f ms, frame %.2f ms CPU / %.2f ms GPU (median of "
-                "%d)\n",
-                options.technique.c_str(), scene.name.c_str(), scene.settings.width,
-                scene.settings.height, ctx.deviceName().c_str(), setup.totalMs,
-                cpu["median"].is_number() ? cpu["median"].get<double>() : -1.0,
-                gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
-    for (const std::string& s : harness.skipped()) std::printf("  skipped %s\n", s.c_str());
+    std::printf(
+        "%s on %s (%dx%d, %s): set-up %.1f ms, frame %.2f ms CPU / %.2f ms GPU (median of "
+        "%d)\n",
+        options.technique.c_str(), scene.name.c_str(), scene.settings.width, scene.settings.height,
+        ctx.deviceName().c_str(), setup.totalMs,
+        cpu["median"].is_number() ? cpu["median"].get<double>() : -1.0,
+        gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
+    for (const std::string& s : harness.skipped())
+        std::printf("  skipped %s\n", s.c_str());
     std::printf("  wrote %s.{exr,png,json}\n", base.string().c_str());
     if (ctx.validationErrorCount() > 0)
         std::fprintf(stderr, "gilab: %u Vulkan validation errors (see the JSON sidecar)\n",
                      ctx.validationErrorCount());
     if (nonFinite) {
-        std::fprintf(stderr, "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s.json)\n",
+        std::fprintf(stderr,
+                     "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s.json)\n",
                      nonFinite, base.string().c_str());
         return kExitNonFinite;
     }

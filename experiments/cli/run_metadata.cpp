@@ -32,7 +32,9 @@ std::string hostName() {
     return gethostname(buf, sizeof buf - 1) == 0 ? std::string(buf) : "unknown";
 }
 
-nlohmann::ordered_json vec3Json(const glm::vec3& v) { return {v.x, v.y, v.z}; }
+nlohmann::ordered_json vec3Json(const glm::vec3& v) {
+    return {v.x, v.y, v.z};
+}
 
 /** NaN is not valid JSON: a NaN measurement is written as null. */
 nlohmann::ordered_json number(double v) {
@@ -153,7 +155,8 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
                           {"cpu_record_ms", summaryJson(record[name])}});
     }
     for (size_t i = 0; i < frames.size(); ++i)
-        for (const vk::PassTime& p : frames[i].passes) gpuTotal[i] += p.gpuMs;
+        for (const vk::PassTime& p : frames[i].passes)
+            gpuTotal[i] += p.gpuMs;
     return {{"policy", "docs/timing.md: warm-up discarded; median and IQR over timed frames"},
             {"setup_ms",
              {{"scene_upload", setup.sceneUploadMs},
@@ -171,8 +174,10 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
 
 nlohmann::ordered_json memoryJson(const MemoryReport& memory) {
     nlohmann::ordered_json owners, tags;
-    for (const auto& [name, bytes] : memory.byOwner) owners[name] = bytes;
-    for (const auto& [name, bytes] : memory.byTag) tags[name] = bytes;
+    for (const auto& [name, bytes] : memory.byOwner)
+        owners[name] = bytes;
+    for (const auto& [name, bytes] : memory.byTag)
+        tags[name] = bytes;
     return {{"total_bytes", memory.totalBytes},
             {"peak_bytes", memory.peakBytes},
             {"by_owner", owners},
