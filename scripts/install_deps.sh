@@ -10,7 +10,8 @@ PACKAGES=(
     libglm-dev libtinygltf-dev nlohmann-json3-dev libstb-dev
     libopenimageio-dev openimageio-tools libopenexr-dev
     libembree-dev libtbb-dev
-    libcli11-dev
+    libcli11-dev libxxhash-dev
+    python3-matplotlib chromium fonts-dejavu-core
     libgtest-dev libgmock-dev
 )
 

@@ -4,9 +4,9 @@
 #include <cmath>
 #include <vector>
 
-#include "core/scene/json_reader.h"
 #include "core/scene/mesh_builder.h"
 #include "core/util/error.h"
+#include "core/util/json_reader.h"
 
 namespace gilab {
 

@@ -4,8 +4,8 @@
 
 #include <glm/gtc/constants.hpp>
 
-#include "core/scene/json_reader.h"
 #include "core/util/error.h"
+#include "core/util/json_reader.h"
 
 namespace gilab {
 

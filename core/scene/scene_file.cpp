@@ -8,10 +8,10 @@
 #include <nlohmann/json.hpp>
 
 #include "core/scene/gltf_loader.h"
-#include "core/scene/json_reader.h"
 #include "core/scene/scene_description.h"
 #include "core/scene/scene_loader.h"
 #include "core/util/error.h"
+#include "core/util/json_reader.h"
 
 namespace gilab {
 

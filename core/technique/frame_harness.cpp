@@ -128,15 +128,17 @@ FrameTiming FrameHarness::renderFrame() {
     FrameTiming t;
     Stopwatch sw;
     TechniqueContext ctx = makeContext();
+    vk::GpuTimer* timer = m_timestamps ? m_timer.get() : nullptr;
+    ctx.timer = timer;
     m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
-        m_timer->reset(cmd);
-        m_shared->record(cmd, m_scene.camera, m_timer.get());
+        if (timer) timer->reset(cmd);
+        m_shared->record(cmd, m_scene.camera, timer);
         m_indirect->clearColor(cmd, VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}});
         FrameTargets targets{*m_indirect, m_shared->direct()};
         m_technique->render(ctx, cmd, targets);
     });
     t.cpuMs = sw.elapsedMs();
-    t.passes = m_timer->resolve();
+    if (timer) t.passes = timer->resolve();
     return t;
 }
 

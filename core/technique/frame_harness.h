@@ -63,6 +63,8 @@ public:
     /** Throws gilab::Error if the technique does not support the scene. */
     SetupTiming setup();
     FrameTiming renderFrame();
+    /** Frames without timestamp queries (to measure the instrumentation's own cost). */
+    void setTimestampsEnabled(bool enabled) { m_timestamps = enabled; }
     /** Changes technique parameters between frames; calls onParamsChanged with changed keys. */
     void updateParams(const ParamSet& techniqueParams);
 
@@ -90,6 +92,7 @@ private:
     std::vector<std::string> m_notes;
     std::vector<PassTimeRecord> m_setupTimes;
     bool m_ready = false;
+    bool m_timestamps = true;
 };
 
 }  // namespace gilab

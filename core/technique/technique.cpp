@@ -25,7 +25,16 @@ void TechniqueContext::submitTimed(const std::function<void(VkCommandBuffer)>& r
     });
     if (!timer || !setupTimes) return;
     for (const vk::PassTime& p : timer->resolve())
-        setupTimes->push_back({techniqueId + "/" + p.name, p.gpuMs});
+        setupTimes->push_back({p.name, p.gpuMs});
+}
+
+PassScope::PassScope(const TechniqueContext& ctx, VkCommandBuffer cmd, const std::string& name)
+    : m_timer(ctx.timer), m_cmd(cmd) {
+    if (m_timer) m_timer->begin(cmd, ctx.techniqueId + "/" + name);
+}
+
+PassScope::~PassScope() {
+    if (m_timer) m_timer->end(m_cmd);
 }
 
 SupportResult Technique::checkSupport(const Scene& scene, const ParamSet&) const {

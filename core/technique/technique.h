@@ -84,7 +84,7 @@ struct TechniqueContext {
     const ParamSet& params;
     uint32_t width = 0;
     uint32_t height = 0;
-    vk::GpuTimer* timer = nullptr;  // name sub-passes with vk::ScopedGpuPass(*timer, cmd, "...")
+    vk::GpuTimer* timer = nullptr;  // may be null: name passes with PassScope, not directly
     std::vector<std::string>* skipped = nullptr;  // "pass: reason" lines for the run's metadata
     std::vector<std::string>* notes = nullptr;    // other facts worth recording
 
@@ -93,13 +93,30 @@ struct TechniqueContext {
     void skip(const std::string& pass, const std::string& reason) const;
     void note(const std::string& text) const;
     /**
-     * For set-up work on the GPU: records with `record` (use ScopedGpuPass with `timer` inside
-     * to name the passes, e.g. "voxelize"), submits and waits; the pass times are added to the
-     * run's set-up timing. Not for use inside render().
+     * For set-up work on the GPU: records with `record` (use PassScope inside to name the
+     * passes, e.g. "voxelize"), submits and waits; the pass times are added to the run's set-up
+     * timing. Not for use inside render().
      */
     void submitTimed(const std::function<void(VkCommandBuffer)>& record) const;
     std::string techniqueId;
     std::vector<PassTimeRecord>* setupTimes = nullptr;  // internal: filled by submitTimed
+};
+
+/**
+ * Times one pass of a technique with GPU timestamps, named "<technique id>/<name>":
+ *     { PassScope pass(ctx, cmd, "inject"); ...record... }
+ * Does nothing when the harness runs without timestamps.
+ */
+class PassScope {
+public:
+    PassScope(const TechniqueContext& ctx, VkCommandBuffer cmd, const std::string& name);
+    ~PassScope();
+    PassScope(const PassScope&) = delete;
+    PassScope& operator=(const PassScope&) = delete;
+
+private:
+    vk::GpuTimer* m_timer;
+    VkCommandBuffer m_cmd;
 };
 
 /** The images of one frame. `indirect` is cleared to zero before render() is called. */

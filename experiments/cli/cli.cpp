@@ -1,6 +1,11 @@
 #include "experiments/cli/cli.h"
 
+#include <unistd.h>
+
+#include <charconv>
 #include <cstdio>
+#include <fstream>
+#include <tuple>
 
 #include <CLI/CLI.hpp>
 
@@ -58,6 +63,108 @@ int runMain(int argc, char** argv) {
     rend->add_flag("--validation", render.validation, "Enable Vulkan validation layers");
     rend->add_flag("--quiet,-q", render.quiet, "No progress lines");
 
+    ReferenceOptions reference;
+    reference.commandLine = commandLine;
+    CLI::App* ref = app.add_subcommand(
+        "reference",
+        "Path-trace the ground truth (cached): EXR mean + stderr layers, PNG, JSON sidecar");
+    ref->add_option(
+        "--scene", reference.scenePath,
+        "Scene description (.json, optionally #variant); default: built-in Cornell box");
+    ref->add_option("--spp", reference.spp, "Stop at this many samples per pixel")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
+    ref->add_option("--rel-error", reference.relError,
+                    "Stop when the mean relative standard error of `full` is below this")
+        ->check(CLI::Range(1e-9, 10.0));
+    ref->add_option("--time", reference.seconds, "Stop after this many seconds of rendering")
+        ->check(CLI::Range(1e-3, 1e9));
+    ref->add_option("--max-bounces", reference.maxBounces, "Indirect bounces (0 = direct only)")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    ref->add_option("--roulette-depth", reference.rouletteDepth,
+                    "Russian roulette after this bounce; -1 = off")
+        ->check(CLI::Range(-1, 1024))
+        ->capture_default_str();
+    ref->add_option("--estimator", reference.estimator, "Light estimator")
+        ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
+        ->capture_default_str();
+    ref->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
+    ref->add_option("--batch", reference.batchSamples,
+                    "Samples per pass (stop criteria are checked between passes; no effect on "
+                    "the image)")
+        ->check(CLI::Range(1u, 65536u))
+        ->capture_default_str();
+    ref->add_option("--resolution", reference.resolution, "Override the scene resolution, WxH");
+    CLI::Option* cacheOpt = ref->add_option(
+        "--cache", reference.cacheDir,
+        "Reference cache folder (default: $GILAB_REFERENCE_CACHE or results/cache/reference)");
+    ref->add_flag("--no-cache", reference.noCache, "Neither read nor write the cache")
+        ->excludes(cacheOpt);
+    ref->add_option("--out,-o", reference.outDir, "Output folder")->required();
+    ref->add_option("--long-reference", reference.longReference,
+                    "EXR of a longer render: adds the relative-MSE-vs-samples curve")
+        ->check(CLI::ExistingFile);
+    ref->add_flag("--quiet,-q", reference.quiet, "No progress lines");
+
+    BenchReferenceOptions benchRef;
+    benchRef.commandLine = commandLine;
+    CLI::App* bench = app.add_subcommand("bench", "Benchmarks that print figures");
+    bench->require_subcommand(1);
+    CLI::App* benchRefCmd = bench->add_subcommand(
+        "reference", "Path tracer ray rates vs raw Embree, and time to a relative MSE of 1e-3");
+    benchRefCmd->add_option(
+        "--scene", benchRef.scenes,
+        "Scene (repeatable); default: built-in Cornell box and scenes/sponza.json");
+    benchRefCmd->add_option("--spp", benchRef.spp, "Samples per pixel of the timed render")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 20))
+        ->capture_default_str();
+    benchRefCmd->add_option("--resolution", benchRef.resolution, "Override the resolution, WxH");
+    benchRefCmd
+        ->add_option("--long-spp", benchRef.longSpp,
+                     "Samples of the long run for the convergence figure (0 = 8x the estimated "
+                     "samples needed)")
+        ->capture_default_str();
+    benchRefCmd
+        ->add_option("--long-max-seconds", benchRef.longMaxSeconds,
+                     "Time cap of the long run and of the run measured against it")
+        ->check(CLI::Range(0.1, 1e6))
+        ->capture_default_str();
+    benchRefCmd->add_option("--target-rel-mse", benchRef.targetRelMse, "Convergence target")
+        ->check(CLI::Range(1e-9, 1.0))
+        ->capture_default_str();
+    benchRefCmd->add_option("--max-bounces", benchRef.maxBounces, "Indirect bounces")
+        ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    benchRefCmd->add_option("--out,-o", benchRef.outDir, "Also write bench_reference.json here");
+    benchRefCmd->add_flag("--quiet,-q", benchRef.quiet, "No progress lines");
+
+    exp::RunnerOptions run;
+    run.commandLine = commandLine;
+    std::string shard;
+    CLI::App* runCmd = app.add_subcommand(
+        "run", "Run an experiment config: every scene x technique x sweep point vs the reference");
+    runCmd->add_option("config", run.configPath, "Experiment config (.json)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    runCmd->add_option("--out,-o", run.outRoot, "Results root; runs go to <out>/<experiment>/")
+        ->capture_default_str();
+    runCmd->add_option("--shard", shard, "Run only the slice i/N (runs whose index % N == i)");
+    runCmd->add_option("--reference-cache", run.referenceCacheDir,
+                       "Reference cache folder (default: $GILAB_REFERENCE_CACHE or "
+                       "results/cache/reference)");
+    runCmd->add_option("--device", run.device, "Vulkan device name substring or index");
+    runCmd->add_flag("--validation", run.validation, "Enable Vulkan validation layers");
+    runCmd->add_flag("--dry-run", run.dryRun, "List the runs and which are finished; run nothing");
+    runCmd->add_flag("--quiet,-q", run.quiet, "No progress lines");
+
+    std::vector<std::string> reportDirs;
+    std::string reportOut;
+    CLI::App* reportCmd = app.add_subcommand(
+        "report", "Write report.html (+ figures/*.svg) from results folders (shards are merged)");
+    reportCmd->add_option("dirs", reportDirs, "Results folder(s), e.g. results/default")
+        ->required();
+    reportCmd->add_option("--out,-o", reportOut, "Output folder (default: the first folder)");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -69,6 +176,13 @@ int runMain(int argc, char** argv) {
         if (*devices) return runDevices(deviceFilter);
         if (*info) return runSceneInfo(infoScene, infoJson);
         if (*rend) return runRender(render);
+        if (*ref) return runReference(reference);
+        if (*benchRefCmd) return runBenchReference(benchRef);
+        if (*runCmd) {
+            if (!shard.empty()) std::tie(run.shardIndex, run.shardCount) = exp::parseShard(shard);
+            return runExperimentCommand(run);
+        }
+        if (*reportCmd) return runReport(reportDirs, reportOut);
     } catch (const Error& e) {
         std::fprintf(stderr, "gilab: error: %s\n", e.what());
         return kExitError;
@@ -77,6 +191,34 @@ int runMain(int argc, char** argv) {
         return kExitError;
     }
     return kExitUsage;
+}
+
+void applyResolutionOverride(Scene& scene, const std::string& text) {
+    if (text.empty()) return;
+    const size_t x = text.find('x');
+    int w = 0, h = 0;
+    const bool ok = x != std::string::npos &&
+                    std::from_chars(text.data(), text.data() + x, w).ptr == text.data() + x &&
+                    std::from_chars(text.data() + x + 1, text.data() + text.size(), h).ptr ==
+                        text.data() + text.size();
+    if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384)
+        throw Error("--resolution \"" + text + "\": expected WxH with 1 <= W, H <= 16384");
+    scene.settings.width = w;
+    scene.settings.height = h;
+}
+
+void writeJsonAtomic(const std::string& path, const nlohmann::ordered_json& json) {
+    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+    {
+        std::ofstream out(tmp);
+        out << json.dump(2) << "\n";
+        out.flush();
+        if (!out) throw Error("cannot write " + tmp);
+    }
+    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+        std::remove(tmp.c_str());
+        throw Error("cannot rename " + tmp + " to " + path);
+    }
 }
 
 }  // namespace gilab::cli

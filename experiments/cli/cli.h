@@ -1,7 +1,15 @@
 #pragma once
 /** The gilab command line: `gilab --help` lists the commands. */
+#include <atomic>
+#include <cstdint>
 #include <string>
 #include <vector>
+
+#include "experiments/runner/runner.h"
+
+#include <nlohmann/json.hpp>
+
+#include "core/scene/scene.h"
 
 namespace gilab::cli {
 
@@ -32,8 +40,57 @@ struct RenderOptions {
 };
 int runRender(const RenderOptions& options);
 
+/** Options of `gilab reference` (docs/reference_cache.md), also used by tests. */
+struct ReferenceOptions {
+    std::string scenePath;  // "" = the built-in Cornell box
+    uint64_t spp = 0;       // stop criteria: whichever comes first; none set = 64 spp
+    double relError = 0.0;
+    double seconds = 0.0;
+    int maxBounces = 32;
+    int rouletteDepth = -1;
+    std::string estimator = "mis";  // mis | nee | bsdf
+    uint64_t seed = 1;
+    uint32_t batchSamples = 4;
+    std::string resolution;  // "WxH", "" = the scene's
+    std::string cacheDir;    // "" = $GILAB_REFERENCE_CACHE or results/cache/reference
+    bool noCache = false;
+    std::string outDir = "results/reference";
+    std::string longReference;  // EXR of a longer run: adds the MSE-vs-samples curve
+    bool quiet = false;
+    std::string commandLine;
+    /** Cancel flag (tests); null = Ctrl-C (SIGINT) cancels, a second Ctrl-C kills. */
+    const std::atomic<bool>* cancel = nullptr;
+};
+int runReference(const ReferenceOptions& options);
+
+/** Options of `gilab bench reference`. */
+struct BenchReferenceOptions {
+    std::vector<std::string> scenes;  // empty = built-in Cornell box and scenes/sponza.json
+    uint64_t spp = 16;                // samples of the timed render
+    std::string resolution;           // "WxH", "" = each scene's
+    uint64_t longSpp = 0;             // long run for the convergence figure; 0 = automatic
+    double longMaxSeconds = 120.0;    // cap of the long run (and of the run measured against it)
+    double targetRelMse = 1e-3;
+    int maxBounces = 32;
+    std::string outDir;  // "" = print only
+    bool quiet = false;
+    std::string commandLine;
+};
+int runBenchReference(const BenchReferenceOptions& options);
+
+/** `gilab run CONFIG`; see experiments/runner/runner.h. */
+int runExperimentCommand(const exp::RunnerOptions& options);
+/** `gilab report DIR...`: runs scripts/report/make_report.py with Debian's python3. */
+int runReport(const std::vector<std::string>& dirs, const std::string& outDir);
+
 int runList(bool json);
 int runDevices(const std::string& device);
 int runSceneInfo(const std::string& scenePath, bool json);
+
+// Helpers shared by the commands
+/** Sets the scene resolution from "WxH" ("" = keep); throws gilab::Error on bad text. */
+void applyResolutionOverride(Scene& scene, const std::string& text);
+/** Writes `json` (2-space indent) to a temporary file, then renames it over `path`. */
+void writeJsonAtomic(const std::string& path, const nlohmann::ordered_json& json);
 
 }  // namespace gilab::cli

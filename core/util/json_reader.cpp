@@ -1,4 +1,4 @@
-#include "core/scene/json_reader.h"
+#include "core/util/json_reader.h"
 
 #include <cmath>
 #include <sstream>

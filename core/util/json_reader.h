@@ -1,6 +1,6 @@
 #pragma once
 /**
- * Strict, typed access to a parsed JSON document, used by the scene description reader.
+ * Strict, typed access to a parsed JSON document (scene descriptions, experiment configs).
  *
  * Every value carries the file it came from and its key path ("lights[0].color"), so each
  * error names both: `scenes/x.json: "lights[0].intensity": must be >= 0 (got -1)`. Objects list

@@ -1,0 +1,64 @@
+// `gilab run CONFIG` and `gilab report DIR`.
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "core/util/build_info.h"
+#include "core/util/error.h"
+#include "experiments/cli/cli.h"
+#include "experiments/cli/interrupt.h"
+#include "experiments/runner/runner.h"
+
+namespace gilab::cli {
+
+int runExperimentCommand(const exp::RunnerOptions& options) {
+    InterruptScope interrupt(
+        "\ngilab: interrupted: stopping after the current run; finished runs are kept "
+        "(Ctrl-C again to abort)\n");
+    const exp::RunnerSummary s = exp::runExperiment(options, &interrupt.flag());
+    if (options.dryRun) return kExitOk;
+    std::printf("%s: %zu runs (%zu in this shard): %zu already finished, %zu ran (%zu unsupported, "
+                "%zu with non-finite pixels)%s\n",
+                s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.ran,
+                s.unsupported, s.nonfinite, s.cancelled ? ", interrupted" : "");
+    std::printf("report: gilab report %s\n", s.dir.string().c_str());
+    if (s.cancelled || interrupt.interrupted()) return kExitInterrupted;
+    return s.nonfinite ? kExitNonFinite : kExitOk;
+}
+
+int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
+    for (const std::string& d : dirs)
+        if (!std::filesystem::is_directory(d)) throw Error("report: no such results folder: " + d);
+    const char* env = std::getenv("GILAB_REPORT_SCRIPT");
+    const std::string script =
+        env && *env ? env : std::string(build::kSourceDir) + "/scripts/report/make_report.py";
+    if (!std::filesystem::exists(script))
+        throw Error("report: the report script is missing: " + script +
+                    " (set GILAB_REPORT_SCRIPT to its path)");
+    const char* python = "/usr/bin/python3";  // Debian's, with python3-matplotlib
+    std::vector<std::string> args{python, script};
+    args.insert(args.end(), dirs.begin(), dirs.end());
+    if (!outDir.empty()) {
+        args.push_back("--out");
+        args.push_back(outDir);
+    }
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    std::fflush(stdout);
+    const pid_t pid = ::fork();
+    if (pid < 0) throw Error("report: cannot start " + std::string(python));
+    if (pid == 0) {
+        ::execv(python, argv.data());
+        std::perror("gilab: report: cannot run /usr/bin/python3 (install python3-matplotlib)");
+        std::_Exit(127);
+    }
+    int status = 0;
+    ::waitpid(pid, &status, 0);
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0 ? kExitOk : kExitError;
+}
+
+}  // namespace gilab::cli

@@ -1,0 +1,377 @@
+#include "experiments/runner/experiment_config.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "core/passes/shared_passes.h"
+#include "core/technique/frame_harness.h"
+#include "core/technique/registry.h"
+#include "core/util/error.h"
+#include "core/util/json_reader.h"
+
+namespace gilab::exp {
+namespace {
+
+namespace fs = std::filesystem;
+
+SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defaultW, int defaultH) {
+    SceneEntry entry;
+    std::string spec;
+    entry.width = defaultW;
+    entry.height = defaultH;
+    if (node.raw().is_string()) {
+        spec = node.string();
+    } else {
+        node.expectKeys({"scene", "resolution", "label"});
+        spec = node["scene"].string();
+        if (node.has("resolution")) {
+            const JsonNode r = node["resolution"];
+            if (r.arraySize() != 2) r.fail("expected [width, height]");
+            entry.width = r.item(0).integerIn(1, 16384);
+            entry.height = r.item(1).integerIn(1, 16384);
+        }
+        if (node.has("label")) entry.label = node["label"].string();
+    }
+    if (spec.empty()) node.fail("empty scene");
+    const size_t hash = spec.find('#');
+    std::string file = spec.substr(0, hash);
+    if (hash != std::string::npos) entry.variant = spec.substr(hash + 1);
+    if (file == "builtin") {
+        if (!entry.variant.empty()) node.fail("the built-in scene has no variants");
+        entry.path.clear();
+    } else {
+        fs::path p(file);
+        if (p.is_relative()) p = fs::path(baseDir) / p;
+        if (!fs::exists(p)) node.fail("scene file not found: " + p.lexically_normal().string());
+        entry.path = p.lexically_normal().string();
+    }
+    if (entry.label.empty()) {
+        entry.label = entry.path.empty() ? "builtin" : fs::path(entry.path).stem().string();
+        if (!entry.variant.empty()) entry.label += "#" + entry.variant;
+    }
+    return entry;
+}
+
+ReferenceRequest parseReference(const JsonNode& node) {
+    ReferenceRequest r;
+    node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce", "seed",
+                     "estimator", "batch_spp"});
+    if (node.has("spp")) r.stop.maxSamples = uint64_t(node["spp"].integerIn(1, 1 << 24));
+    if (node.has("rel_error")) r.stop.targetRelError = node["rel_error"].numberIn(0.0, 10.0);
+    if (node.has("time_s")) r.stop.maxSeconds = node["time_s"].numberIn(0.0, 1e7);
+    if (r.stop.maxSamples == 0 && r.stop.targetRelError == 0.0 && r.stop.maxSeconds == 0.0)
+        node.fail("needs at least one stop criterion: spp, rel_error or time_s");
+    if (node.has("max_bounces")) r.settings.maxBounces = node["max_bounces"].integerIn(0, 1024);
+    if (node.has("roulette_start_bounce"))
+        r.settings.rouletteStartBounce = node["roulette_start_bounce"].integerIn(-1, 1024);
+    if (node.has("seed")) r.settings.seed = uint64_t(node["seed"].integerIn(0, 1 << 30));
+    if (node.has("batch_spp")) r.settings.batchSamples = uint32_t(node["batch_spp"].integerIn(1, 4096));
+    if (node.has("estimator")) {
+        const std::string e = node["estimator"].string();
+        if (e == "mis") r.settings.estimator = ref::Estimator::Mis;
+        else if (e == "nee") r.settings.estimator = ref::Estimator::NeeOnly;
+        else if (e == "bsdf") r.settings.estimator = ref::Estimator::BsdfOnly;
+        else node["estimator"].fail("expected mis, nee or bsdf (got \"" + e + "\")");
+    }
+    return r;
+}
+
+MetricOptionsSpec parseMetrics(const JsonNode& node) {
+    MetricOptionsSpec m;
+    node.expectKeys({"ppd", "exposure_ev", "regions"});
+    if (node.has("ppd")) m.ppd = node["ppd"].numberIn(1.0, 1000.0);
+    if (node.has("exposure_ev")) m.exposureEv = float(node["exposure_ev"].numberIn(-40.0, 40.0));
+    if (node.has("regions")) {
+        const JsonNode regions = node["regions"];
+        std::set<std::string> names;
+        for (size_t i = 0; i < regions.arraySize(); ++i) {
+            const JsonNode r = regions.item(i);
+            r.expectKeys({"name", "rect", "indirect_fraction_above"});
+            RegionSpec spec;
+            spec.name = r["name"].string();
+            if (!names.insert(spec.name).second) r["name"].fail("duplicate region name");
+            if (r.has("rect") == r.has("indirect_fraction_above"))
+                r.fail("a region needs exactly one of rect or indirect_fraction_above");
+            if (r.has("rect")) {
+                const JsonNode rect = r["rect"];
+                if (rect.arraySize() != 4) rect.fail("expected [x0, y0, x1, y1] in 0..1");
+                std::array<double, 4> v{};
+                for (size_t k = 0; k < 4; ++k) v[k] = rect.item(k).numberIn(0.0, 1.0);
+                if (v[2] <= v[0] || v[3] <= v[1]) rect.fail("empty rectangle (need x1 > x0, y1 > y0)");
+                spec.rect = v;
+            } else {
+                spec.indirectFractionAbove = r["indirect_fraction_above"].numberIn(0.0, 1.0);
+            }
+            m.regions.push_back(spec);
+        }
+    }
+    return m;
+}
+
+std::map<std::string, nlohmann::json> parseAssignments(const JsonNode& node, ParamSet params) {
+    std::map<std::string, nlohmann::json> out;
+    if (!node.raw().is_object()) node.fail("expected an object of parameter values");
+    for (const auto& [key, value] : node.raw().items()) {
+        try {
+            params.setJson(key, value);  // validates name, type and range now
+        } catch (const Error& e) {
+            node.fail(e.what());
+        }
+        out[key] = value;
+    }
+    return out;
+}
+
+/** The parameter set a swept key belongs to: "shared.<key>" sweeps a shared-pass parameter. */
+struct AxisTarget {
+    ParamSet* params;
+    std::string key;
+};
+
+AxisTarget axisTarget(const std::string& key, ParamSet& technique, ParamSet& shared) {
+    if (key.rfind("shared.", 0) == 0) return {&shared, key.substr(7)};
+    return {&technique, key};
+}
+
+std::vector<std::pair<std::string, std::vector<nlohmann::json>>> parseAxes(const JsonNode& node,
+                                                                           ParamSet technique,
+                                                                           ParamSet shared) {
+    std::vector<std::pair<std::string, std::vector<nlohmann::json>>> axes;
+    if (!node.raw().is_object() || node.raw().empty())
+        node.fail("expected a non-empty object {parameter: values}");
+    for (const auto& [key, value] : node.raw().items()) {
+        const JsonNode axis = node[key.c_str()];
+        const AxisTarget target = axisTarget(key, technique, shared);
+        if (!target.params->has(target.key)) {
+            ParamSet probe = *target.params;
+            try {
+                probe.set(target.key, "0");  // throws the unknown-key message with the valid keys
+            } catch (const Error& e) {
+                axis.fail(e.what());
+            }
+        }
+        const bool integer = target.params->spec(target.key).type == ParamType::Int;
+        std::vector<nlohmann::json> values;
+        if (value.is_array()) {
+            values.assign(value.begin(), value.end());
+        } else if (value.is_object()) {
+            values = expandRange(value, integer, axis.context() + ": \"" + axis.path() + "\"");
+        } else {
+            axis.fail("expected a list of values or a range {\"linear\"|\"log\": [from, to, count]}");
+        }
+        if (values.empty()) axis.fail("no values to sweep");
+        ParamSet probe = *target.params;
+        for (const nlohmann::json& v : values) {
+            try {
+                probe.setJson(target.key, v);
+            } catch (const Error& e) {
+                axis.fail(e.what());
+            }
+        }
+        axes.emplace_back(key, std::move(values));
+    }
+    return axes;
+}
+
+TechniqueEntry parseTechnique(const JsonNode& node) {
+    node.expectKeys({"technique", "params", "sweep", "shared"});
+    TechniqueEntry t;
+    t.id = node["technique"].string();
+    ParamSet params;
+    try {
+        params = TechniqueRegistry::instance().defaultParams(t.id);
+    } catch (const Error& e) {
+        node["technique"].fail(e.what());
+    }
+    if (node.has("params")) t.fixed = parseAssignments(node["params"], params);
+    for (const auto& [k, v] : t.fixed) params.setJson(k, v);
+    if (node.has("shared")) t.shared = parseAssignments(node["shared"], defaultSharedParams());
+    if (node.has("sweep")) {
+        const JsonNode sweep = node["sweep"];
+        sweep.expectKeys({"grid", "zip"});
+        const ParamSet shared = defaultSharedParams();
+        if (sweep.has("grid")) t.grid = parseAxes(sweep["grid"], params, shared);
+        if (sweep.has("zip")) {
+            t.zip = parseAxes(sweep["zip"], params, shared);
+            for (const auto& [key, values] : t.zip)
+                if (values.size() != t.zip.front().second.size())
+                    sweep["zip"].fail("zipped lists must have equal lengths (\"" + key + "\" has " +
+                                      std::to_string(values.size()) + ", \"" + t.zip.front().first +
+                                      "\" has " + std::to_string(t.zip.front().second.size()) + ")");
+        }
+        std::set<std::string> seen;
+        for (const auto& axes : {t.grid, t.zip})
+            for (const auto& [key, values] : axes) {
+                if (!seen.insert(key).second || t.fixed.count(key) ||
+                    (key.rfind("shared.", 0) == 0 && t.shared.count(key.substr(7))))
+                    sweep.fail("parameter \"" + key + "\" is set more than once");
+            }
+    }
+    return t;
+}
+
+}  // namespace
+
+std::vector<nlohmann::json> expandRange(const nlohmann::json& range, bool integer,
+                                        const std::string& where) {
+    if (range.size() != 1 || !(range.contains("linear") || range.contains("log")))
+        throw Error(where + ": a range is {\"linear\": [from, to, count]} or {\"log\": [...]}");
+    const bool log = range.contains("log");
+    const nlohmann::json& a = log ? range["log"] : range["linear"];
+    if (!a.is_array() || a.size() != 3 || !a[0].is_number() || !a[1].is_number() ||
+        !a[2].is_number_integer())
+        throw Error(where + ": range needs [from, to, count] with an integer count");
+    const double from = a[0].get<double>(), to = a[1].get<double>();
+    const int count = a[2].get<int>();
+    if (!std::isfinite(from) || !std::isfinite(to) || count < 1 || count > 1000)
+        throw Error(where + ": range from/to must be finite and count in [1, 1000]");
+    if (log && (from <= 0.0 || to <= 0.0))
+        throw Error(where + ": a log range needs positive from and to");
+    std::vector<nlohmann::json> values;
+    for (int i = 0; i < count; ++i) {
+        const double t = count == 1 ? 0.0 : double(i) / double(count - 1);
+        const double v = log ? from * std::pow(to / from, t) : from + (to - from) * t;
+        if (integer) {
+            const long long r = std::llround(v);
+            if (values.empty() || values.back().get<long long>() != r) values.push_back(r);
+        } else {
+            values.push_back(v);
+        }
+    }
+    return values;
+}
+
+nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec) {
+    nlohmann::ordered_json regions = nlohmann::ordered_json::array();
+    for (const RegionSpec& r : spec.regions) {
+        nlohmann::ordered_json j = {{"name", r.name}};
+        if (r.rect) j["rect"] = *r.rect;
+        else j["indirect_fraction_above"] = r.indirectFractionAbove;
+        regions.push_back(j);
+    }
+    return {{"ppd", spec.ppd}, {"exposure_ev", spec.exposureEv}, {"regions", regions}};
+}
+
+ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::string& context,
+                                       const std::string& baseDir) {
+    const JsonNode root(json, context);
+    root.expectKeys({"name", "description", "scenes", "resolution", "reference", "timing", "metrics",
+                     "shared", "techniques"});
+    ExperimentConfig c;
+    c.path = context;
+    c.name = root["name"].string();
+    for (char ch : c.name)
+        if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
+            root["name"].fail("use letters, digits, '_' and '-' only (it names a folder)");
+    if (root.has("description")) c.description = root["description"].string();
+    int w = 0, h = 0;
+    if (root.has("resolution")) {
+        const JsonNode r = root["resolution"];
+        if (r.arraySize() != 2) r.fail("expected [width, height]");
+        w = r.item(0).integerIn(1, 16384);
+        h = r.item(1).integerIn(1, 16384);
+    }
+    const JsonNode scenes = root["scenes"];
+    if (scenes.arraySize() == 0) scenes.fail("needs at least one scene");
+    std::set<std::string> labels;
+    for (size_t i = 0; i < scenes.arraySize(); ++i) {
+        c.scenes.push_back(parseScene(scenes.item(i), baseDir, w, h));
+        if (!labels.insert(c.scenes.back().label).second)
+            scenes.item(i).fail("duplicate scene label \"" + c.scenes.back().label + "\"");
+    }
+    if (!root.has("reference")) root.fail("missing \"reference\" (the ground-truth settings)");
+    c.reference = parseReference(root["reference"]);
+    if (root.has("timing")) {
+        const JsonNode t = root["timing"];
+        t.expectKeys({"warmup", "frames"});
+        if (t.has("warmup")) c.timing.warmupFrames = t["warmup"].integerIn(0, 1000);
+        if (t.has("frames")) c.timing.timedFrames = t["frames"].integerIn(1, 100000);
+    }
+    if (root.has("metrics")) c.metrics = parseMetrics(root["metrics"]);
+    if (root.has("shared")) c.shared = parseAssignments(root["shared"], defaultSharedParams());
+    const JsonNode techniques = root["techniques"];
+    if (techniques.arraySize() == 0) techniques.fail("needs at least one technique");
+    for (size_t i = 0; i < techniques.arraySize(); ++i)
+        c.techniques.push_back(parseTechnique(techniques.item(i)));
+    expandRuns(c);  // validates every combination (shared limits included) before anything runs
+    return c;
+}
+
+ExperimentConfig loadExperimentConfig(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw Error(path + ": cannot open experiment config");
+    nlohmann::json json;
+    try {
+        json = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw Error(path + ": malformed JSON: " + e.what());
+    }
+    const std::string baseDir = fs::path(path).parent_path().string();
+    return parseExperimentConfig(json, path, baseDir.empty() ? "." : baseDir);
+}
+
+std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
+    std::vector<RunSpec> runs;
+    for (const SceneEntry& scene : config.scenes) {
+        for (const TechniqueEntry& t : config.techniques) {
+            ParamSet base = TechniqueRegistry::instance().defaultParams(t.id);
+            for (const auto& [k, v] : t.fixed) base.setJson(k, v);
+            ParamSet shared = defaultSharedParams();
+            for (const auto& [k, v] : config.shared) shared.setJson(k, v);
+            for (const auto& [k, v] : t.shared) shared.setJson(k, v);
+            try {
+                (void)sharedSettingsFromParams(shared);
+            } catch (const Error& e) {
+                throw Error(config.path + ": technique \"" + t.id + "\": " + e.what());
+            }
+
+            // Grid: cartesian product; zip: lock-step; the two are combined as a product.
+            std::vector<std::map<std::string, nlohmann::json>> points{{}};
+            for (const auto& [key, values] : t.grid) {
+                std::vector<std::map<std::string, nlohmann::json>> next;
+                for (const auto& p : points)
+                    for (const nlohmann::json& v : values) {
+                        auto q = p;
+                        q[key] = v;
+                        next.push_back(std::move(q));
+                    }
+                points = std::move(next);
+            }
+            if (!t.zip.empty()) {
+                std::vector<std::map<std::string, nlohmann::json>> next;
+                for (const auto& p : points)
+                    for (size_t i = 0; i < t.zip.front().second.size(); ++i) {
+                        auto q = p;
+                        for (const auto& [key, values] : t.zip) q[key] = values[i];
+                        next.push_back(std::move(q));
+                    }
+                points = std::move(next);
+            }
+            for (const auto& point : points) {
+                RunSpec run;
+                run.index = runs.size();
+                run.scene = &scene;
+                run.techniqueId = t.id;
+                run.params = base;
+                run.shared = shared;
+                for (const auto& [k, v] : point) {
+                    const AxisTarget target = axisTarget(k, run.params, run.shared);
+                    target.params->setJson(target.key, v);
+                    run.swept[k] = target.params->getText(target.key);
+                }
+                try {
+                    (void)sharedSettingsFromParams(run.shared);
+                } catch (const Error& e) {
+                    throw Error(config.path + ": technique \"" + t.id + "\" " +
+                                run.shared.toString() + ": " + e.what());
+                }
+                runs.push_back(std::move(run));
+            }
+        }
+    }
+    return runs;
+}
+
+}  // namespace gilab::exp

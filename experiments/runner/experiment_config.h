@@ -1,0 +1,98 @@
+#pragma once
+/**
+ * Experiment configs (JSON, docs/experiments.md): scenes x techniques x parameter sweeps, the
+ * reference settings, the timing policy and the metric options. Everything is validated when the
+ * file is read — unknown keys, unknown techniques, out-of-range parameters and malformed sweeps
+ * are errors naming the file and the key path — before any run starts.
+ */
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "core/image/image_io.h"
+#include "core/params/params.h"
+#include "reference/path_tracer.h"
+
+namespace gilab::exp {
+
+struct SceneEntry {
+    std::string path;     // scene description, relative paths resolved against the config; "" = built-in
+    std::string variant;  // "" = the file's base setup
+    int width = 0;        // 0 = the scene's own resolution
+    int height = 0;
+    std::string label;  // e.g. "cornell_box#spot"; unique within the experiment
+};
+
+struct ReferenceRequest {
+    ref::ReferenceSettings settings;
+    ref::StopCriteria stop;
+};
+
+struct TimingPolicy {
+    int warmupFrames = 2;
+    int timedFrames = 5;
+};
+
+/** A named region for metrics: a rectangle (normalised 0..1) or an indirect-light mask. */
+struct RegionSpec {
+    std::string name;
+    std::optional<std::array<double, 4>> rect;  // x0, y0, x1, y1 in [0, 1]
+    double indirectFractionAbove = -1.0;        // > 0: pixels whose reference indirect > x * total
+};
+
+struct MetricOptionsSpec {
+    double ppd = 67.0;
+    float exposureEv = 0.0f;  // LDR metrics and previews; added to the scene's exposure
+    std::vector<RegionSpec> regions;
+};
+
+/** One technique block: fixed parameters plus sweeps (grid = cartesian, zip = lock-step). */
+struct TechniqueEntry {
+    std::string id;
+    std::map<std::string, nlohmann::json> fixed;
+    std::vector<std::pair<std::string, std::vector<nlohmann::json>>> grid;
+    std::vector<std::pair<std::string, std::vector<nlohmann::json>>> zip;
+    std::map<std::string, nlohmann::json> shared;  // shared-pass overrides for this technique
+};
+
+struct ExperimentConfig {
+    std::string name;
+    std::string path;
+    std::string description;
+    std::vector<SceneEntry> scenes;
+    ReferenceRequest reference;
+    TimingPolicy timing;
+    MetricOptionsSpec metrics;
+    std::map<std::string, nlohmann::json> shared;  // shared-pass parameters for every run
+    std::vector<TechniqueEntry> techniques;
+};
+
+ExperimentConfig loadExperimentConfig(const std::string& path);
+/** Parses from memory; `context` (e.g. the path) prefixes every message. */
+ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::string& context,
+                                       const std::string& baseDir);
+
+/** One run: a scene, a technique and one point of its sweep. */
+struct RunSpec {
+    size_t index = 0;  // position in the expanded list (stable for a given config)
+    const SceneEntry* scene = nullptr;
+    std::string techniqueId;
+    ParamSet params;
+    ParamSet shared;
+    std::map<std::string, std::string> swept;  // swept key -> canonical value text
+};
+
+/** Expands every technique block into runs (scenes outermost), validating every value. */
+std::vector<RunSpec> expandRuns(const ExperimentConfig& config);
+
+/** The metric options as JSON (part of every run's identity). */
+nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec);
+
+/** Values of a range object {"linear": [from, to, count]} or {"log": [from, to, count]}. */
+std::vector<nlohmann::json> expandRange(const nlohmann::json& range, bool integer,
+                                        const std::string& where);
+
+}  // namespace gilab::exp

@@ -1,0 +1,47 @@
+#pragma once
+/**
+ * The reference of one scene, split so that each technique is compared with the light it claims
+ * to compute (docs/experiments.md, "Bounce matching"):
+ *   n = 0 bounces        emission + direct
+ *   n indirect bounces   emission + direct + bounce1 + ... + bounce_n   (bounce3plus for n >= 3
+ *                        only when the reference's max_bounces <= n, else the full image)
+ *   all bounces          full
+ * The matched standard error is sqrt(sum of the layers' variances) (layers' covariance ignored:
+ * they come from the same paths, so this is an approximation; for "all" the full layer's own
+ * standard error is used, which is exact).
+ */
+#include <string>
+#include <vector>
+
+#include "core/image/image.h"
+#include "reference/cache.h"
+
+namespace gilab::exp {
+
+struct MatchedReference {
+    std::string name;  // e.g. "emission+direct+bounce1"
+    Image final;       // what the technique's `final` layer is compared with
+    Image finalStdError;
+    Image indirect;  // what its `indirect` layer is compared with (empty for 0 bounces)
+    Image indirectStdError;
+    Image fullIndirect;  // all indirect light of the reference (regions, "vs full" metrics)
+    Image full;
+    Image fullStdError;
+};
+
+class ReferenceSet {
+public:
+    explicit ReferenceSet(ref::ReferenceResult result);
+    const ref::ReferenceResult& result() const { return m_result; }
+    /** `bounces` as TechniqueInfo::indirectBounces (kAllBounces = all). */
+    MatchedReference match(int bounces) const;
+
+private:
+    const Image& mean(ref::Layer layer) const;
+    const Image& stdError(ref::Layer layer) const;
+    ref::ReferenceResult m_result;
+    std::vector<ImageLayer> m_mean;
+    std::vector<ImageLayer> m_stdError;
+};
+
+}  // namespace gilab::exp

@@ -1,0 +1,81 @@
+#include "experiments/runner/run_metrics.h"
+
+#include <cmath>
+
+#include "core/util/error.h"
+#include "experiments/metrics/metrics.h"
+
+namespace gilab::exp {
+namespace {
+
+const Image& layerImage(const std::vector<ImageLayer>& layers, const std::string& name) {
+    for (const ImageLayer& l : layers)
+        if (l.name == name) return l.image;
+    throw Error("run output has no layer \"" + name + "\"");
+}
+
+metrics::Mask regionMask(const RegionSpec& r, const MatchedReference& ref) {
+    const int w = ref.full.width(), h = ref.full.height();
+    if (r.rect) {
+        const auto& v = *r.rect;
+        return metrics::Mask::fromNormalizedRects(w, h, {{v[0], v[1], v[2], v[3]}});
+    }
+    return metrics::Mask::fromIndirectFraction(ref.fullIndirect, ref.full,
+                                               100.0 * r.indirectFractionAbove);
+}
+
+}  // namespace
+
+nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
+                                         const MatchedReference& reference, int bounces,
+                                         const MetricOptionsSpec& spec, const ToneMap& tonemap,
+                                         const std::filesystem::path& outDir) {
+    const Image& final = layerImage(layers, "final");
+    const Image& indirect = layerImage(layers, "indirect");
+
+    metrics::MetricOptions options;
+    options.tonemap = tonemap;
+    options.ppd = spec.ppd;
+
+    nlohmann::ordered_json out;
+    metrics::MetricMaps maps;
+    options.referenceStdError = &reference.finalStdError;
+    out["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, options, &maps));
+    metrics::writeMagmaPng((outDir / "flip.png").string(), maps.flip);
+
+    // Against all the light, whatever the technique claims: how far from full GI it is.
+    options.referenceStdError = &reference.fullStdError;
+    options.resampleFlip = false;
+    out["final_vs_full"] = metrics::toJson(metrics::computeMetrics(final, reference.full, options));
+
+    if (bounces != 0 && !reference.indirect.empty()) {
+        options.referenceStdError = &reference.indirectStdError;
+        out["indirect"] =
+            metrics::toJson(metrics::computeMetrics(indirect, reference.indirect, options));
+    }
+    const Image& refIndirect = reference.indirect.empty() ? reference.fullIndirect : reference.indirect;
+    const double energy = metrics::computeEnergyRatio(indirect, refIndirect);
+    out["energy_ratio"] = std::isfinite(energy) ? nlohmann::ordered_json(energy) : nullptr;
+
+    if (!spec.regions.empty()) {
+        nlohmann::ordered_json regions;
+        for (const RegionSpec& r : spec.regions) {
+            metrics::MetricOptions ro = options;
+            ro.mask = regionMask(r, reference);
+            ro.referenceStdError = &reference.finalStdError;
+            nlohmann::ordered_json entry;
+            entry["pixels"] = ro.mask->count();
+            entry["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, ro));
+            if (bounces != 0 && !reference.indirect.empty()) {
+                ro.referenceStdError = &reference.indirectStdError;
+                entry["indirect"] =
+                    metrics::toJson(metrics::computeMetrics(indirect, reference.indirect, ro));
+            }
+            regions[r.name] = entry;
+        }
+        out["regions"] = regions;
+    }
+    return out;
+}
+
+}  // namespace gilab::exp

@@ -1,0 +1,65 @@
+#pragma once
+/**
+ * results/<experiment>/: results that are never lost.
+ *
+ *   runs/<key>/result.json   one folder per finished run (plus its EXR, PNGs, FLIP map)
+ *   runs/.tmp-<key>-<pid>/   a run in progress; renamed to runs/<key>/ only when complete, so a
+ *                            killed run never leaves a folder that looks finished
+ *   references/<label>/      the bounce-matched reference images each run was compared with
+ *   results.jsonl            append-only table, one JSON object per finished run
+ *   results.csv              the same rows as CSV (flat columns)
+ * A run's key is a hash of its resolved configuration: re-running a config skips keys whose
+ * folder holds a finished result.json and redoes only what changed.
+ */
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace gilab::exp {
+
+class RunStore {
+public:
+    explicit RunStore(std::filesystem::path experimentDir);
+
+    const std::filesystem::path& dir() const { return m_dir; }
+    std::filesystem::path runDir(const std::string& key) const;
+    /** True when runs/<key>/result.json exists and records a final status. */
+    bool isFinished(const std::string& key) const;
+
+    /** A fresh temporary folder for a run (stale ones of this key are removed first). */
+    std::filesystem::path beginRun(const std::string& key) const;
+    /** Moves the temporary folder to runs/<key>/ (atomic rename). */
+    void commitRun(const std::filesystem::path& tmpDir, const std::string& key) const;
+
+    /** Appends one row to results.jsonl and results.csv (flushed and synced). */
+    void appendRow(const nlohmann::ordered_json& row) const;
+
+    /** Every finished run's result.json, sorted by run index then key. */
+    std::vector<nlohmann::json> loadFinished() const;
+
+private:
+    std::filesystem::path m_dir;
+};
+
+/** Statuses that mark a run as done (not retried): "ok", "nonfinite", "unsupported". */
+bool isFinalStatus(const std::string& status);
+
+/** Flattens nested objects to "a.b.c" columns for CSV (arrays are JSON-encoded in one cell). */
+void flattenJson(const nlohmann::json& value, const std::string& prefix,
+                 std::vector<std::pair<std::string, std::string>>& out);
+
+/** A label safe as a folder name: letters, digits, '-', '_' kept; everything else -> '_'. */
+std::string sanitizeLabel(const std::string& label);
+
+/**
+ * The flat row of the results tables for a run's result.json: identity, parameters (as
+ * "k=v ..."), status, set-up and frame times, memory, the headline metrics, provenance.
+ */
+nlohmann::ordered_json resultRow(const nlohmann::ordered_json& result);
+
+/** Writes a file atomically: temporary name, flush, fsync, rename. */
+void writeFileAtomic(const std::filesystem::path& path, const std::string& contents);
+
+}  // namespace gilab::exp

@@ -1,0 +1,293 @@
+#include "experiments/runner/runner.h"
+
+#include <charconv>
+#include <cstdio>
+#include <fstream>
+#include <map>
+#include <memory>
+
+#include "core/image/image_io.h"
+#include "core/passes/shared_passes.h"
+#include "core/scene/scene_loader.h"
+#include "core/technique/frame_harness.h"
+#include "core/technique/registry.h"
+#include "core/util/build_info.h"
+#include "core/util/error.h"
+#include "core/util/hash.h"
+#include "core/util/progress.h"
+#include "core/vk/context.h"
+#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/experiment_config.h"
+#include "experiments/runner/reference_set.h"
+#include "experiments/runner/run_metrics.h"
+#include "experiments/runner/run_store.h"
+#include "experiments/runner/timing_probe.h"
+#include "reference/scene_hash.h"
+
+namespace gilab::exp {
+namespace fs = std::filesystem;
+
+namespace {
+
+/** Bumped when the meaning of a run's result changes, so finished runs are redone. */
+constexpr int kRunFormatVersion = 1;
+
+/** Loads each scene of the experiment once, applying the config's resolution. */
+class SceneCache {
+public:
+    const Scene& get(const SceneEntry& entry) {
+        auto it = m_scenes.find(entry.label);
+        if (it != m_scenes.end()) return *it->second;
+        auto scene = std::make_unique<Scene>(entry.path.empty()
+                                                 ? makeBuiltinDefaultScene()
+                                                 : loadSceneFile(entry.path, entry.variant));
+        if (entry.width > 0) {
+            scene->settings.width = entry.width;
+            scene->settings.height = entry.height;
+        }
+        for (const std::string& w : scene->warnings)
+            std::fprintf(stderr, "gilab: %s: warning: %s\n", entry.label.c_str(), w.c_str());
+        return *m_scenes.emplace(entry.label, std::move(scene)).first->second;
+    }
+
+private:
+    std::map<std::string, std::unique_ptr<Scene>> m_scenes;
+};
+
+/** Everything that changes a run's result, hashed: the run key. */
+nlohmann::ordered_json runIdentity(const ExperimentConfig& config, const RunSpec& run,
+                                   const Scene& scene) {
+    return {{"run_format", kRunFormatVersion},
+            {"scene_label", run.scene->label},
+            {"reference_key", ref::referenceKey(scene, config.reference.settings)},
+            {"reference_stop", ref::stopCriteriaJson(config.reference.stop)},
+            {"technique", run.techniqueId},
+            {"params", run.params.toOrderedJson()},
+            {"shared", run.shared.toOrderedJson()},
+            {"warmup", config.timing.warmupFrames},
+            {"frames", config.timing.timedFrames},
+            {"metrics", metricsSpecJson(config.metrics)}};
+}
+
+struct Context {
+    const ExperimentConfig& config;
+    const RunnerOptions& options;
+    RunStore& store;
+    vk::Context& vk;
+    ref::ReferenceCache* cache;
+    SceneCache scenes;
+    std::map<std::string, std::unique_ptr<ReferenceSet>> references;
+    std::map<std::string, bool> writtenReferencePreviews;
+    const std::atomic<bool>* cancel;
+};
+
+const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene) {
+    auto it = c.references.find(entry.label);
+    if (it != c.references.end()) return *it->second;
+    ref::ObtainOptions opts;
+    opts.cancel = c.cancel;
+    opts.sidecarExtra["scene"] = cli::sceneToJson(scene);
+    opts.sidecarExtra["provenance"] = cli::provenanceJson(c.options.commandLine);
+    std::fprintf(stderr, "[gilab] reference for %s\n", entry.label.c_str());
+    ref::ReferenceResult r = ref::obtainReference(scene, c.config.reference.settings,
+                                                  c.config.reference.stop, c.cache, opts);
+    for (const std::string& w : r.warnings) std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
+    if (!r.complete)
+        throw Error("reference for " + entry.label + " was interrupted (" +
+                    ref::stopReasonName(r.reason) + "); runs need a complete reference");
+    return *c.references.emplace(entry.label, std::make_unique<ReferenceSet>(std::move(r)))
+                .first->second;
+}
+
+/** references/<label>/<matched>.{exr,png}: written once per experiment folder. */
+nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry,
+                                             const MatchedReference& m, const ToneMap& tm) {
+    const std::string safeLabel = sanitizeLabel(entry.label);
+    const fs::path dir = c.store.dir() / "references" / safeLabel;
+    const fs::path png = dir / (m.name + ".png"), exr = dir / (m.name + ".exr");
+    const std::string id = safeLabel + "/" + m.name;
+    if (!c.writtenReferencePreviews[id]) {
+        fs::create_directories(dir);
+        writeExrLayers(exr.string(), {{"final", m.final}, {"final_stderr", m.finalStdError}});
+        writePngTonemapped(png.string(), m.final, tm);
+        c.writtenReferencePreviews[id] = true;
+    }
+    return {{"final_png", "../../references/" + safeLabel + "/" + m.name + ".png"},
+            {"final_exr", "../../references/" + safeLabel + "/" + m.name + ".exr"}};
+}
+
+std::string statusOf(size_t nonFinite) { return nonFinite ? "nonfinite" : "ok"; }
+
+/** Executes one run into a temporary folder and commits it. Returns its status. */
+std::string executeRun(Context& c, const RunSpec& run, const std::string& key, size_t position,
+                       size_t count) {
+    const Scene& scene = c.scenes.get(*run.scene);
+    const TechniqueInfo& info = TechniqueRegistry::instance().get(run.techniqueId);
+    const fs::path tmp = c.store.beginRun(key);
+
+    nlohmann::ordered_json result;
+    result["schema"] = 1;
+    result["status"] = "running";
+    result["key"] = key;
+    result["index"] = run.index;
+    result["experiment"] = c.config.name;
+    result["scene"] = {{"label", run.scene->label},
+                       {"path", run.scene->path},
+                       {"variant", run.scene->variant},
+                       {"resolution", {scene.settings.width, scene.settings.height}}};
+    nlohmann::ordered_json swept = nlohmann::ordered_json::object();
+    for (const auto& [k, v] : run.swept) swept[k] = v;
+    result["technique"] = {{"id", info.id},
+                           {"description", info.description},
+                           {"citation", info.citation},
+                           {"indirect_bounces", info.indirectBounces},
+                           {"params", run.params.toOrderedJson()},
+                           {"swept", swept}};
+    result["shared_params"] = run.shared.toOrderedJson();
+    result["provenance"] = cli::provenanceJson(c.options.commandLine);
+    result["device"] = cli::deviceJson(c.vk);
+
+    FrameHarness harness(c.vk, scene, run.techniqueId, run.params, run.shared);
+    if (!harness.support().supported) {
+        result["status"] = "unsupported";
+        result["reason"] = harness.support().reason;
+        writeFileAtomic(tmp / "result.json", result.dump(2));
+        c.store.commitRun(tmp, key);
+        c.store.appendRow(resultRow(result));
+        return "unsupported";
+    }
+
+    const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
+    const MatchedReference matched = refs.match(info.indirectBounces);
+    ToneMap tm;
+    tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
+    result["reference"] = {{"key", refs.result().key},
+                           {"samples", refs.result().acc.samples},
+                           {"rel_error", ref::meanRelativeStdError(refs.result().acc)},
+                           {"matched", matched.name}};
+    result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
+
+    Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
+                          info.id + " on " + run.scene->label,
+                      size_t(c.config.timing.warmupFrames + c.config.timing.timedFrames));
+    const SetupTiming setup = harness.setup();
+    std::vector<FrameTiming> frames;
+    const int total = c.config.timing.warmupFrames + c.config.timing.timedFrames;
+    for (int i = 0; i < total; ++i) {
+        FrameTiming t = harness.renderFrame();
+        if (i >= c.config.timing.warmupFrames) frames.push_back(std::move(t));
+        progress.update(size_t(i + 1));
+    }
+    progress.finish();
+
+    const std::vector<ImageLayer> layers = harness.readLayers();
+    size_t nonFinite = 0;
+    result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
+    result["timing"] = cli::timingJson(setup, frames, c.config.timing.warmupFrames);
+    result["memory"] = cli::memoryJson(harness.memory());
+    result["skipped_passes"] = harness.skipped();
+    result["notes"] = harness.notes();
+    result["metrics"] =
+        computeRunMetrics(layers, matched, info.indirectBounces, c.config.metrics, tm, tmp);
+    result["validation"] = {{"errors", c.vk.validationErrorCount()},
+                            {"warnings", c.vk.validationWarningCount()}};
+
+    writeExrLayers((tmp / "output.exr").string(), layers);
+    writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
+    writePngTonemapped((tmp / "indirect.png").string(), layers[1].image, tm);
+    result["outputs"] = {{"exr", "output.exr"},
+                         {"final_png", "final.png"},
+                         {"indirect_png", "indirect.png"},
+                         {"flip_png", "flip.png"}};
+    result["status"] = statusOf(nonFinite);
+    writeFileAtomic(tmp / "result.json", result.dump(2));
+    c.store.commitRun(tmp, key);
+    c.store.appendRow(resultRow(result));
+    return result["status"];
+}
+
+}  // namespace
+
+std::pair<int, int> parseShard(const std::string& text) {
+    const size_t slash = text.find('/');
+    int i = -1, n = 0;
+    const bool ok =
+        slash != std::string::npos &&
+        std::from_chars(text.data(), text.data() + slash, i).ptr == text.data() + slash &&
+        std::from_chars(text.data() + slash + 1, text.data() + text.size(), n).ptr ==
+            text.data() + text.size();
+    if (!ok || n < 1 || i < 0 || i >= n)
+        throw Error("--shard \"" + text + "\": expected i/N with 0 <= i < N");
+    return {i, n};
+}
+
+RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool>* cancel) {
+    Progress::setQuiet(options.quiet);
+    const ExperimentConfig config = loadExperimentConfig(options.configPath);
+    const std::vector<RunSpec> runs = expandRuns(config);
+
+    RunnerSummary summary;
+    summary.total = runs.size();
+    summary.dir = fs::path(options.outRoot) / config.name;
+    RunStore store(summary.dir);
+
+    std::ifstream configIn(options.configPath);
+    const std::string configText((std::istreambuf_iterator<char>(configIn)), {});
+    nlohmann::ordered_json experiment = {{"name", config.name},
+                                         {"description", config.description},
+                                         {"config_path", options.configPath},
+                                         {"config_hash", hashHex128(configText)},
+                                         {"config", nlohmann::json::parse(configText)},
+                                         {"runs_total", runs.size()},
+                                         {"gilab_version", build::kVersion},
+                                         {"git_commit", build::kGitCommit}};
+
+    std::vector<const RunSpec*> mine;
+    for (const RunSpec& r : runs)
+        if (int(r.index % size_t(options.shardCount)) == options.shardIndex) mine.push_back(&r);
+    summary.inShard = mine.size();
+
+    SceneCache probeScenes;
+    std::vector<std::string> keys;
+    for (const RunSpec* r : mine)
+        keys.push_back(hashHex128(runIdentity(config, *r, probeScenes.get(*r->scene)).dump()));
+    if (options.dryRun) {
+        for (size_t i = 0; i < mine.size(); ++i)
+            std::printf("%4zu %s %-12s %-24s %s %s\n", mine[i]->index, keys[i].substr(0, 12).c_str(),
+                        mine[i]->techniqueId.c_str(), mine[i]->scene->label.c_str(),
+                        mine[i]->params.toString().c_str(),
+                        store.isFinished(keys[i]) ? "[done]" : "[todo]");
+        return summary;
+    }
+
+    vk::ContextOptions vkOptions;
+    vkOptions.validation = options.validation;
+    vkOptions.deviceFilter = options.device;
+    vk::Context vk(vkOptions);
+    std::unique_ptr<ref::ReferenceCache> cache = std::make_unique<ref::ReferenceCache>(
+        options.referenceCacheDir.empty() ? ref::ReferenceCache::defaultDir()
+                                          : fs::path(options.referenceCacheDir));
+    experiment["device"] = cli::deviceJson(vk);
+    experiment["instrumentation"] =
+        measureInstrumentationOverhead(vk, probeScenes.get(config.scenes.front()));
+    writeFileAtomic(summary.dir / ("experiment.json"), experiment.dump(2));
+
+    Context c{config, options, store, vk, cache.get(), {}, {}, {}, cancel};
+    for (size_t i = 0; i < mine.size(); ++i) {
+        if (cancel && cancel->load()) {
+            summary.cancelled = true;
+            break;
+        }
+        if (store.isFinished(keys[i])) {
+            ++summary.alreadyFinished;
+            continue;
+        }
+        const std::string status = executeRun(c, *mine[i], keys[i], i + 1, mine.size());
+        ++summary.ran;
+        if (status == "unsupported") ++summary.unsupported;
+        if (status == "nonfinite") ++summary.nonfinite;
+    }
+    return summary;
+}
+
+}  // namespace gilab::exp

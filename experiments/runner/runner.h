@@ -1,0 +1,45 @@
+#pragma once
+/**
+ * `gilab run CONFIG`: expands an experiment config into runs and executes the ones not finished
+ * yet (docs/experiments.md). Each run: set-up once (timed), W warm-up frames, N timed frames,
+ * outputs saved, metrics against the bounce-matched reference (from the reference cache),
+ * memory, skipped passes; then its folder is committed atomically and a row appended to the
+ * results tables. Killing the process loses no finished run.
+ */
+#include <atomic>
+#include <filesystem>
+#include <string>
+
+namespace gilab::exp {
+
+struct RunnerOptions {
+    std::string configPath;
+    std::string outRoot = "results";  // results/<experiment name>/
+    int shardIndex = 0;               // --shard i/N: runs whose index % N == i
+    int shardCount = 1;
+    std::string device;
+    bool validation = false;
+    bool quiet = false;
+    std::string referenceCacheDir;  // "" = ReferenceCache::defaultDir()
+    bool dryRun = false;            // list the runs and whether each is done; run nothing
+    std::string commandLine;
+};
+
+struct RunnerSummary {
+    std::filesystem::path dir;
+    size_t total = 0;           // runs in the config
+    size_t inShard = 0;         // runs of this shard
+    size_t alreadyFinished = 0;
+    size_t ran = 0;
+    size_t unsupported = 0;
+    size_t nonfinite = 0;
+    bool cancelled = false;
+};
+
+RunnerSummary runExperiment(const RunnerOptions& options,
+                            const std::atomic<bool>* cancel = nullptr);
+
+/** Parses "i/N" (0 <= i < N); throws gilab::Error otherwise. */
+std::pair<int, int> parseShard(const std::string& text);
+
+}  // namespace gilab::exp

@@ -1,0 +1,89 @@
+#pragma once
+/**
+ * The scene's world-space triangle mesh in Embree 3: one RTCDevice, one RTCScene (robust
+ * flag, high-quality BVH) holding one triangle geometry, plus the per-triangle data the path
+ * tracer shades with. Alpha-masked materials get intersection and occlusion filters that apply
+ * the rasteriser's cutout rule (coverage = baseColorFactor.a x texture alpha < alphaCutoff:
+ * the hit is ignored), so cut-out texels neither show nor shadow, for every ray type.
+ *
+ * Embree reports errors through a callback installed once per device; it records the message
+ * and every API call site checks it and throws gilab::Error with Embree's text.
+ */
+#include <cstdint>
+#include <mutex>
+#include <string>
+#include <vector>
+
+#include <embree3/rtcore.h>
+#include <glm/glm.hpp>
+
+#include "core/scene/scene.h"
+
+namespace gilab::ref {
+
+class TextureLookup;
+
+/** One triangle: p = p0 + b1 e1 + b2 e2 with Embree's barycentrics (b1, b2) = (u, v). */
+struct MeshTriangle {
+    glm::vec3 p0, e1, e2;
+    glm::vec3 n;  // unit geometric normal of the counter-clockwise winding (cross(e1, e2))
+    float area = 0.0f;
+    uint32_t material = 0;
+    uint32_t v[3] = {0, 0, 0};  // vertex indices
+};
+
+struct RayHit {
+    float t = 0.0f;
+    uint32_t prim = 0;
+    float u = 0.0f;  // barycentric of vertex 1
+    float v = 0.0f;  // barycentric of vertex 2
+};
+
+class EmbreeScene {
+public:
+    EmbreeScene(const Scene& scene, const TextureLookup& textures);
+    ~EmbreeScene();
+    EmbreeScene(const EmbreeScene&) = delete;
+    EmbreeScene& operator=(const EmbreeScene&) = delete;
+
+    RTCDevice device() const { return m_device; }
+    RTCScene handle() const { return m_scene; }
+    /** Embree's version, e.g. "3.13.5" (RTC_DEVICE_PROPERTY_VERSION). */
+    std::string version() const;
+    /** Whether any triangle has a masked material (the filters are installed). */
+    bool hasAlphaFilter() const { return m_hasAlphaFilter; }
+
+    const MeshTriangle& triangle(uint32_t prim) const { return m_triangles[prim]; }
+    size_t triangleCount() const { return m_triangles.size(); }
+
+    /** Closest hit of o + t d, t in [tNear, tFar] (d need not be unit; t is in units of d). */
+    bool intersect(const glm::vec3& o, const glm::vec3& d, float tNear, float tFar,
+                   RayHit& hit) const;
+    /** Whether anything (not cut out) lies on o + t d, t in [tNear, tFar]. */
+    bool occluded(const glm::vec3& o, const glm::vec3& d, float tNear, float tFar) const;
+    /** Closest hits of up to 16 rays in one rtcIntersect16 call; hit[i].prim = ~0u on a miss.
+     *  Lanes >= count are inactive. */
+    void intersect16(int count, const glm::vec3* o, const glm::vec3* d, float tFar,
+                     RayHit* hit) const;
+
+    /** Throws gilab::Error with Embree's message if the device reports an error. */
+    void checkError(const char* what) const;
+
+private:
+    static void onError(void* user, RTCError code, const char* message);
+
+    const Scene& m_sceneData;
+    const TextureLookup& m_textures;
+    std::vector<MeshTriangle> m_triangles;
+    std::vector<uint8_t> m_masked;  // per triangle: material is alpha-masked
+    bool m_hasAlphaFilter = false;
+    RTCDevice m_device = nullptr;
+    RTCScene m_scene = nullptr;
+
+    mutable std::mutex m_errorMutex;
+    mutable std::string m_lastError;
+
+    friend struct AlphaFilter;
+};
+
+}  // namespace gilab::ref

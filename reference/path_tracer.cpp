@@ -1,0 +1,310 @@
+// PathTracer: scene set-up, the tile/pixel/sample loop (TBB) and the settings description.
+#include "reference/path_tracer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+#include <tbb/parallel_for.h>
+
+#include "core/util/error.h"
+#include "core/util/progress.h"
+#include "reference/bsdf.h"
+#include "reference/embree_scene.h"
+#include "reference/integrator.h"
+#include "reference/lights.h"
+#include "reference/sampling.h"
+#include "reference/texture_lookup.h"
+
+namespace gilab::ref {
+namespace {
+
+constexpr int kTileSize = 8;
+constexpr int kPacketSize = 4;  // camera rays of a 4 x 4 pixel block share one rtcIntersect16
+constexpr int kValuesPerPixel = kLayerCount * 3;
+
+std::atomic<bool> g_cameraPackets{true};
+
+void validate(const Scene& scene, const ReferenceSettings& s) {
+    if (s.maxBounces < 0) throw Error("reference: maxBounces must be >= 0");
+    if (s.rouletteStartBounce < -1) throw Error("reference: rouletteStartBounce must be >= -1");
+    if (s.batchSamples < 1) throw Error("reference: batchSamples must be >= 1");
+    if (scene.settings.width < 1 || scene.settings.height < 1)
+        throw Error("scene '" + scene.name + "': invalid resolution");
+    const int texCount = int(scene.textures.size());
+    for (const Material& m : scene.materials) {
+        for (int t : {m.baseColorTexture, m.metallicRoughnessTexture, m.emissiveTexture}) {
+            if (t >= texCount)
+                throw Error("material '" + m.name + "' uses texture " + std::to_string(t) + " of " +
+                            std::to_string(texCount));
+        }
+    }
+}
+
+}  // namespace
+
+void setCameraPackets(bool enabled) {
+    g_cameraPackets = enabled;
+}
+
+const char* layerName(Layer layer) {
+    switch (layer) {
+        case Layer::Full:
+            return "full";
+        case Layer::Emission:
+            return "emission";
+        case Layer::Direct:
+            return "direct";
+        case Layer::Bounce1:
+            return "bounce1";
+        case Layer::Bounce2:
+            return "bounce2";
+        case Layer::Bounce3Plus:
+            return "bounce3plus";
+    }
+    return "?";
+}
+
+const char* estimatorName(Estimator e) {
+    switch (e) {
+        case Estimator::Mis:
+            return "mis";
+        case Estimator::NeeOnly:
+            return "nee";
+        case Estimator::BsdfOnly:
+            return "bsdf";
+    }
+    return "?";
+}
+
+struct PathTracer::Impl {
+    Impl(const Scene& s, const ReferenceSettings& st)
+        : scene((validate(s, st), s)),
+          settings(st),
+          textures(scene.textures),
+          mesh(scene, textures),
+          lights(scene, textures, mesh),
+          integrator(scene, settings, mesh, lights, textures) {}
+
+    /** Renders samples [first, first + count) of one tile into `sum`/`sumSq` (which hold the
+     *  accumulator's values of those pixels on entry). */
+    void renderTile(int tx, int ty, uint64_t first, uint32_t count, const Accumulator& acc,
+                    std::vector<double>& outSum, std::vector<double>& outSumSq,
+                    PathCounters& counters, uint64_t& nonFinite, bool packets);
+
+    const Scene scene;  // a copy: the tracer never depends on the caller's lifetime
+    const ReferenceSettings settings;
+    const TextureLookup textures;
+    EmbreeScene mesh;  // non-const only for embree() (benchmarks)
+    const LightSampler lights;
+    const Integrator integrator;
+    RayStats stats;
+    std::vector<RecordedRay>* sink = nullptr;
+    std::vector<double> scratchSum, scratchSumSq;
+};
+
+void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count,
+                                  const Accumulator& acc, std::vector<double>& outSum,
+                                  std::vector<double>& outSumSq, PathCounters& counters,
+                                  uint64_t& nonFinite, bool packets) {
+    const int w = acc.width, h = acc.height;
+    const int x0 = tx * kTileSize, y0 = ty * kTileSize;
+    const int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
+    const int tw = x1 - x0;
+    const int pixels = tw * (y1 - y0);
+
+    // The tile's running sums, starting from the accumulator's (per pixel: layer, channel)
+    double sum[kTileSize * kTileSize][kValuesPerPixel];
+    double sumSq[kTileSize * kTileSize][kValuesPerPixel];
+    for (int p = 0; p < pixels; ++p) {
+        const int x = x0 + p % tw, y = y0 + p / tw;
+        for (int l = 0; l < kLayerCount; ++l)
+            for (int c = 0; c < 3; ++c) {
+                const size_t i = acc.index(Layer(l), x, y, c);
+                sum[p][l * 3 + c] = acc.sum[i];
+                sumSq[p][l * 3 + c] = acc.sumSq[i];
+            }
+    }
+
+    // Adds one sample in sample order; a sample with a NaN/Inf in any layer adds nothing
+    auto add = [&](int p, const PathRadiance& r) {
+        for (int l = 0; l < kLayerCount; ++l)
+            if (!isFinite(r.L[l])) {
+                ++nonFinite;
+                return;
+            }
+        for (int l = 0; l < kLayerCount; ++l)
+            for (int c = 0; c < 3; ++c) {
+                const double v = double(r.L[l][c]);
+                sum[p][l * 3 + c] += v;
+                sumSq[p][l * 3 + c] += v * v;
+            }
+    };
+
+    const Camera& camera = scene.camera;
+    PathRadiance radiance;
+    if (!packets) {
+        for (int p = 0; p < pixels; ++p) {
+            const int x = x0 + p % tw, y = y0 + p / tw;
+            const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
+            for (uint64_t s = first; s < first + count; ++s) {
+                Sampler sampler(settings.seed, pixelIndex, s);
+                const glm::vec2 u = sampler.get2D();  // box filter over the pixel
+                const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
+                integrator.radiance(ray, nullptr, sampler, radiance, counters, sink);
+                add(p, radiance);
+            }
+        }
+    } else {
+        // Samples outermost: each pixel still receives its samples in index order
+        for (uint64_t s = first; s < first + count; ++s) {
+            for (int by = y0; by < y1; by += kPacketSize) {
+                for (int bx = x0; bx < x1; bx += kPacketSize) {
+                    Sampler samplers[16];
+                    glm::vec3 o[16], d[16];
+                    int tilePixel[16];
+                    int n = 0;
+                    for (int y = by; y < std::min(by + kPacketSize, y1); ++y)
+                        for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x) {
+                            const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
+                            samplers[n] = Sampler(settings.seed, pixelIndex, s);
+                            const glm::vec2 u = samplers[n].get2D();
+                            const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
+                            o[n] = ray.origin;
+                            d[n] = ray.direction;
+                            tilePixel[n] = (y - y0) * tw + (x - x0);
+                            ++n;
+                        }
+                    RayHit hits[16];
+                    mesh.intersect16(n, o, d, std::numeric_limits<float>::infinity(), hits);
+                    for (int i = 0; i < n; ++i) {
+                        integrator.radiance({o[i], d[i]}, &hits[i], samplers[i], radiance, counters,
+                                            sink);
+                        add(tilePixel[i], radiance);
+                    }
+                }
+            }
+        }
+    }
+
+    for (int p = 0; p < pixels; ++p) {
+        const int x = x0 + p % tw, y = y0 + p / tw;
+        for (int l = 0; l < kLayerCount; ++l)
+            for (int c = 0; c < 3; ++c) {
+                const size_t i = acc.index(Layer(l), x, y, c);
+                outSum[i] = sum[p][l * 3 + c];
+                outSumSq[i] = sumSq[p][l * 3 + c];
+            }
+    }
+}
+
+PathTracer::PathTracer(const Scene& scene, const ReferenceSettings& settings)
+    : m_impl(std::make_unique<Impl>(scene, settings)) {}
+
+PathTracer::~PathTracer() = default;
+
+bool PathTracer::addSamples(Accumulator& acc, uint32_t count, const std::atomic<bool>* cancel) {
+    Impl& im = *m_impl;
+    const int w = im.scene.settings.width, h = im.scene.settings.height;
+    const size_t n = size_t(kLayerCount) * size_t(w) * size_t(h) * 3;
+    if (acc.width != w || acc.height != h || acc.sum.size() != n || acc.sumSq.size() != n)
+        throw Error("reference: the accumulator is " + std::to_string(acc.width) + "x" +
+                    std::to_string(acc.height) + ", the scene " + std::to_string(w) + "x" +
+                    std::to_string(h) + " (reset it first)");
+    if (count == 0) return true;
+    const Stopwatch watch;
+
+    // Render into scratch sums (initialised from acc per tile); commit only if not cancelled
+    im.scratchSum.resize(n);
+    im.scratchSumSq.resize(n);
+    const int tilesX = (w + kTileSize - 1) / kTileSize, tilesY = (h + kTileSize - 1) / kTileSize;
+    const int tileCount = tilesX * tilesY;
+    const uint64_t first = acc.samples;
+    const bool packets = g_cameraPackets.load();
+    std::atomic<bool> cancelled{false};
+    std::atomic<uint64_t> cameraRays{0}, bounceRays{0}, shadowRays{0}, nonFinite{0};
+    auto runTile = [&](int t) {
+        if (cancelled.load(std::memory_order_relaxed)) return;
+        if (cancel && cancel->load(std::memory_order_relaxed)) {
+            cancelled = true;
+            return;
+        }
+        PathCounters counters;
+        uint64_t tileNonFinite = 0;
+        im.renderTile(t % tilesX, t / tilesX, first, count, acc, im.scratchSum, im.scratchSumSq,
+                      counters, tileNonFinite, packets);
+        cameraRays += counters.cameraRays;
+        bounceRays += counters.bounceRays;
+        shadowRays += counters.shadowRays;
+        nonFinite += tileNonFinite;
+    };
+    if (im.sink) {
+        for (int t = 0; t < tileCount; ++t)  // recording: one thread, tile order
+            runTile(t);
+    } else {
+        tbb::parallel_for(0, tileCount, runTile);
+    }
+
+    im.stats.cameraRays += cameraRays;
+    im.stats.bounceRays += bounceRays;
+    im.stats.shadowRays += shadowRays;
+    im.stats.seconds += watch.elapsedMs() * 1e-3;
+    im.mesh.checkError("tracing rays");
+    if (cancelled) return false;
+    acc.sum.swap(im.scratchSum);
+    acc.sumSq.swap(im.scratchSumSq);
+    acc.samples += count;
+    acc.nonFiniteSamples += nonFinite;
+    im.stats.nonFiniteSamples += nonFinite;
+    return true;
+}
+
+const RayStats& PathTracer::stats() const {
+    return m_impl->stats;
+}
+
+const Scene& PathTracer::scene() const {
+    return m_impl->scene;
+}
+
+const ReferenceSettings& PathTracer::settings() const {
+    return m_impl->settings;
+}
+
+EmbreeScene& PathTracer::embree() {
+    return m_impl->mesh;
+}
+
+void PathTracer::recordRays(std::vector<RecordedRay>* sink) {
+    m_impl->sink = sink;
+}
+
+std::string PathTracer::toString() const {
+    const Impl& im = *m_impl;
+    const ReferenceSettings& s = im.settings;
+    std::ostringstream out;
+    out << "renderer: gilab reference path tracer v" << kRendererVersion << "\n"
+        << "estimator: " << estimatorName(s.estimator)
+        << (s.estimator == Estimator::Mis ? " (power heuristic, beta 2)" : "") << "\n"
+        << "max_bounces: " << s.maxBounces << "\n"
+        << "roulette_start_bounce: " << s.rouletteStartBounce
+        << (s.rouletteStartBounce < 0 ? " (off)" : "") << "\n"
+        << "seed: " << s.seed << "\n"
+        << "batch_samples: " << s.batchSamples << " (does not change the image)\n"
+        << "pixel_filter: box over the pixel\n"
+        << "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
+        << "punctual_lights: " << im.lights.punctualCount() << ", all evaluated at every vertex\n"
+        << "emissive_triangles: " << im.lights.emitterCount()
+        << ", one sample per vertex by luminance power, uniform on the triangle\n"
+        << "bsdf: glTF 2.0 Appendix B (Lambertian when metallic 0 and roughness 1), alpha >= "
+        << kBrdfMinAlpha << "; sampling: cosine + GGX VNDF mixture\n"
+        << "textures: mip 0, bilinear, sRGB decoded before filtering\n"
+        << "non_finite: samples with NaN/Inf are counted and add 0\n"
+        << "embree: " << im.mesh.version() << " (robust, high-quality BVH"
+        << (im.mesh.hasAlphaFilter() ? ", alpha filter" : "") << ")\n";
+    return out.str();
+}
+
+}  // namespace gilab::ref

@@ -1,0 +1,55 @@
+#pragma once
+/**
+ * CPU texture and material lookups of the path tracer, matching the GPU's software sampler
+ * (shaders/common/scene.glsl) at mip 0: texel centres at (i + 0.5) / size, per-axis wrap
+ * (repeat, clamp to edge, mirrored repeat), sRGB decoded to linear per texel *before* bilinear
+ * filtering (alpha is always linear), factors multiplied after filtering.
+ */
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "core/scene/scene.h"
+
+namespace gilab::ref {
+
+/** Reads the Scene's textures in place: the Scene must outlive the lookup. */
+class TextureLookup {
+public:
+    /** Keeps the 8-bit texels with a decode table per texture; throws gilab::Error on a bad
+     *  texture. */
+    explicit TextureLookup(const std::vector<Texture>& textures);
+
+    /** scene.glsl sceneBilinear() at mip 0: bilinear filtering of the decoded texels. */
+    glm::vec4 sample(int texture, glm::vec2 uv) const;
+    /** Mean of the decoded mip-0 texels (used to weight texture-emissive triangles). */
+    glm::vec4 average(int texture) const { return m_textures[size_t(texture)].mean; }
+    size_t count() const { return m_textures.size(); }
+
+private:
+    struct Decoded {
+        int width = 0;
+        int height = 0;
+        WrapMode wrapU = WrapMode::Repeat;
+        WrapMode wrapV = WrapMode::Repeat;
+        bool srgb = true;
+        const uint8_t* rgba = nullptr;  // the Scene's texels, row 0 = v = 0
+        glm::vec4 mean{0.0f};
+    };
+    glm::vec4 fetch(const Decoded& d, int x, int y) const;
+
+    std::vector<Decoded> m_textures;
+    float m_srgbTable[256];
+    float m_linearTable[256];
+};
+
+/** Base colour factor x texture; a = coverage (scene.glsl sampleBaseColor, mip 0). */
+glm::vec4 lookupBaseColor(const Material& m, const TextureLookup& tex, glm::vec2 uv);
+/** Emitted radiance: emissive factor x texture rgb (scene.glsl sampleEmission). */
+glm::vec3 lookupEmission(const Material& m, const TextureLookup& tex, glm::vec2 uv);
+/** (metallic, perceptual roughness): factors x texture (B, G) (scene.glsl sampleMetalRough). */
+glm::vec2 lookupMetalRough(const Material& m, const TextureLookup& tex, glm::vec2 uv);
+/** True = the point is cut out: a Mask (or Blend) material with coverage below the cutoff. */
+bool isCutOut(const Material& m, const TextureLookup& tex, glm::vec2 uv);
+
+}  // namespace gilab::ref

@@ -1,0 +1,129 @@
+#!/usr/bin/python3
+"""Builds the HTML report of one gilab experiment (or of several shard folders, merged).
+
+    /usr/bin/python3 scripts/report/make_report.py DIR [DIR ...] [--out OUTDIR]
+
+Reads DIR/runs/<key>/result.json (run folders starting with '.' are in progress and ignored),
+writes OUTDIR/report.html (self-contained: inline CSS/JS, images by relative path) and
+OUTDIR/figures/*.svg, and prints the path of report.html. OUTDIR defaults to the first DIR.
+Runs found in several DIRs (the same key) are kept once. Every section and number is described
+in docs/report.md.
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import glob
+import os
+import platform
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+
+import report_figures  # noqa: E402
+from report_analysis import (MATCHED, Basis, by_scene, by_technique, best_run,  # noqa: E402
+                             find_sweeps, pareto_fronts, pass_colors, ranking_basis, slug,
+                             technique_colors)
+from report_data import Results, load_results  # noqa: E402
+from report_common import Figures, Page  # noqa: E402
+from report_html import render_page  # noqa: E402
+
+REPO_DOCS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
+                                          "docs"))
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("dirs", nargs="+", metavar="DIR",
+                        help="results folder(s): results/<experiment>/ or shards of one")
+    parser.add_argument("--out", metavar="OUTDIR",
+                        help="where report.html and figures/ go (default: the first DIR)")
+    return parser.parse_args(argv)
+
+
+def check_dirs(dirs: list[str]) -> list[str]:
+    """Messages for every DIR that is not a folder."""
+    return [f"make_report: results folder '{d}' does not exist" if not os.path.exists(d)
+            else f"make_report: '{d}' is not a folder" for d in dirs if not os.path.isdir(d)]
+
+
+def clear_old_figures(fig_dir: str) -> None:
+    """Removes the SVGs of an earlier report (figures/ belongs to the report)."""
+    for path in glob.glob(os.path.join(fig_dir, "*.svg")):
+        os.remove(path)
+
+
+def write_figures(results: Results, colors: dict[str, str], bases: list[Basis],
+                  fig_dir: str) -> Figures:
+    """Draws every figure that applies; returns their paths."""
+    figures = Figures()
+    runs = results.runs
+    if not any(r.measured for r in runs):
+        return figures
+    os.makedirs(fig_dir, exist_ok=True)
+    clear_old_figures(fig_dir)
+    report_figures.configure()
+    passes = pass_colors([name for r in runs for name, _ in r.passes()], colors)
+    for scene, scene_runs in by_scene(runs).items():
+        timed = [r for r in scene_runs if r.measured and r.frame_ms is not None]
+        if timed:
+            path = os.path.join(fig_dir, f"pareto_{slug(scene)}.svg")
+            report_figures.pareto_figure(scene_runs, colors, bases, path, scene)
+            figures.pareto[scene] = path
+        best = [b for b in (best_run(rs) for rs in by_technique(scene_runs).values()) if b]
+        if any(v for b in best for _, v in b.passes() + b.setup_stages()):
+            path = os.path.join(fig_dir, f"passes_{slug(scene)}.svg")
+            report_figures.passes_figure(best, colors, passes, path, scene)
+            figures.passes[scene] = path
+    for sweep in find_sweeps(runs):
+        name = f"sweep_{slug(sweep.technique)}_{slug(sweep.scene)}_{slug(sweep.key)}.svg"
+        path = os.path.join(fig_dir, name)
+        report_figures.sweep_figure(sweep, colors, path)
+        figures.sweeps.append((sweep, path))
+    return figures
+
+
+def tool_versions() -> str:
+    import matplotlib  # already imported by report_figures; only for its version
+
+    return f"Python {platform.python_version()}, matplotlib {matplotlib.__version__}"
+
+
+def build_report(dirs: list[str], out_dir: str) -> str:
+    """Writes out_dir/report.html (and figures) from the runs in dirs; returns its path."""
+    results = load_results(dirs)
+    out_dir = os.path.abspath(out_dir)
+    os.makedirs(out_dir, exist_ok=True)
+    colors = technique_colors([r.technique for r in results.runs])
+    basis = ranking_basis(results.runs)
+    bases = [MATCHED] + ([basis] if basis is not MATCHED else [])
+    figures = write_figures(results, colors, bases, os.path.join(out_dir, "figures"))
+    fronts = {scene: pareto_fronts(rs, basis) for scene, rs in by_scene(results.runs).items()}
+    page = Page(out_dir=out_dir, results=results, colors=colors, figures=figures, basis=basis,
+                bases=bases, fronts=fronts,
+                docs_dir=REPO_DOCS if os.path.isdir(REPO_DOCS) else None,
+                generated=datetime.datetime.now(datetime.timezone.utc)
+                .strftime("%Y-%m-%dT%H:%M:%SZ"),
+                tool_versions=tool_versions())
+    path = os.path.join(out_dir, "report.html")
+    tmp = path + f".tmp-{os.getpid()}"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write(render_page(page))
+    os.replace(tmp, path)
+    return path
+
+
+def main(argv: list[str]) -> int:
+    args = parse_args(argv)
+    problems = check_dirs(args.dirs)
+    if problems:
+        print("\n".join(problems), file=sys.stderr)
+        return 2
+    path = build_report(args.dirs, args.out or args.dirs[0])
+    print(path)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

@@ -1,0 +1,305 @@
+"""The report's derived quantities: colours, best runs, Pareto fronts, sweeps, equal-time and
+equal-error tables. Every definition here is restated in docs/report.md.
+"""
+from __future__ import annotations
+
+import hashlib
+import math
+import re
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+from report_data import Run, num, text
+
+# Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
+TECHNIQUE_PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
+                     "#882255", "#117733", "#332288", "#AA4499", "#44AA99", "#999933")
+BASELINE_COLOR = "#4d4d4d"  # the "direct" technique (no indirect light)
+BASELINE_TECHNIQUES = ("direct",)
+# Shared passes and set-up stages are grey; a technique's own passes are shades of its colour.
+GREYS = ("#cfcfcf", "#a6a6a6", "#7d7d7d", "#bababa", "#919191", "#e3e3e3", "#686868")
+BUDGET_STEPS = (1.0, 2.0, 5.0)
+ERROR_QUANTILES = (0.9, 0.75, 0.5, 0.25, 0.1)
+MIN_COMPARED = 2  # a reference group needs this many ok runs for a front / equal-time table
+
+
+def technique_colors(techniques: list[str]) -> dict[str, str]:
+    """One colour per technique id (sorted order), the same in every figure and table."""
+    colors: dict[str, str] = {}
+    others = [t for t in sorted(set(techniques)) if t not in BASELINE_TECHNIQUES]
+    for i, tech in enumerate(others):
+        colors[tech] = TECHNIQUE_PALETTE[i % len(TECHNIQUE_PALETTE)]
+    for tech in set(techniques) & set(BASELINE_TECHNIQUES):
+        colors[tech] = BASELINE_COLOR
+    return colors
+
+
+def shade(color: str, i: int, n: int) -> str:
+    """Member i of n in one hue, light to dark ('#rrggbb' in and out)."""
+    r, g, b = (int(color[k:k + 2], 16) / 255.0 for k in (1, 3, 5))
+    t = 0.5 if n <= 1 else i / (n - 1)
+    if t < 0.5:
+        a = (0.5 - t) * 1.1  # toward white
+        r, g, b = (c + (1.0 - c) * a for c in (r, g, b))
+    else:
+        a = (t - 0.5) * 0.9  # toward black
+        r, g, b = (c * (1.0 - a) for c in (r, g, b))
+    return "#" + "".join(f"{round(c * 255):02x}" for c in (r, g, b))
+
+
+def pass_owner(name: str, techniques: dict[str, str]) -> Optional[str]:
+    """The technique a pass belongs to ('<id>/<pass>'), None for a shared pass."""
+    for sep in ("/", "."):
+        prefix = name.split(sep, 1)[0]
+        if sep in name and prefix in techniques:
+            return prefix
+    return None
+
+
+def pass_colors(names: list[str], tech_colors: dict[str, str]) -> dict[str, str]:
+    """Shared passes in greys; each technique's passes in shades of its colour."""
+    unique = list(dict.fromkeys(names))
+    owned: dict[Optional[str], list[str]] = {}
+    for name in unique:
+        owned.setdefault(pass_owner(name, tech_colors), []).append(name)
+    colors = {n: GREYS[i % len(GREYS)] for i, n in enumerate(owned.pop(None, []))}
+    for tech, members in owned.items():
+        for i, name in enumerate(members):
+            colors[name] = shade(tech_colors[tech], i, len(members))
+    return colors
+
+
+def slug(label: str) -> str:
+    """A file-name-safe version of a label; a short hash keeps distinct labels distinct."""
+    safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", label).strip("_.") or "x"
+    if safe == label:
+        return safe
+    return f"{safe}-{hashlib.sha1(label.encode('utf-8')).hexdigest()[:6]}"
+
+
+def ordered_unique(values: list[str]) -> list[str]:
+    return list(dict.fromkeys(values))
+
+
+def _none_last(value: Optional[float]) -> tuple[bool, float]:
+    return (value is None, value if value is not None else 0.0)
+
+
+def best_key(run: Run) -> tuple:
+    """Ordering of 'best': lowest mean FLIP, then lowest relMSE, then fastest (None last)."""
+    return (_none_last(run.final.flip_mean), _none_last(run.final.rel_mse),
+            _none_last(run.frame_ms), run.key)
+
+
+def best_run(runs: list[Run]) -> Optional[Run]:
+    """The best ok run (best_key); a nonfinite one only if the technique has no ok run."""
+    for status in ("ok", "nonfinite"):
+        candidates = [r for r in runs if r.status == status]
+        if candidates:
+            return min(candidates, key=best_key)
+    return None
+
+
+def by_scene(runs: list[Run]) -> dict[str, list[Run]]:
+    out: dict[str, list[Run]] = {}
+    for run in runs:
+        out.setdefault(run.scene, []).append(run)
+    return out
+
+
+def by_technique(runs: list[Run]) -> dict[str, list[Run]]:
+    out: dict[str, list[Run]] = {}
+    for run in sorted(runs, key=lambda r: r.technique):
+        out.setdefault(run.technique, []).append(run)
+    return out
+
+
+def pareto_front(runs: list[Run], error: Callable[[Run], Optional[float]]) -> list[Run]:
+    """Ok runs not dominated by another ok run: none is both faster-or-equal and lower-error.
+
+    Sorted by frame time; each point has a strictly lower error than every faster point.
+    """
+    points = [r for r in runs
+              if r.status == "ok" and r.frame_ms is not None and error(r) is not None]
+    points.sort(key=lambda r: (r.frame_ms, error(r)))
+    front: list[Run] = []
+    for run in points:
+        if not front or error(run) < error(front[-1]):
+            if front and front[-1].frame_ms == run.frame_ms:
+                front.pop()  # same time, lower error: the earlier one is dominated
+            front.append(run)
+    return front
+
+
+@dataclass(frozen=True)
+class Basis:
+    """Which reference errors are measured against, for ranking runs against each other.
+
+    "matched": metrics.final, against the reference with the light paths the technique claims
+    (runs are only ranked against runs compared with the same reference); "full":
+    metrics.final_vs_full, against all the light, so every run of a scene is comparable.
+    """
+
+    name: str
+    caption: str
+    flip: Callable[[Run], Optional[float]]
+    flip_sigma: Callable[[Run], Optional[float]]
+    rel_mse: Callable[[Run], Optional[float]]
+    rel_mse_sigma: Callable[[Run], Optional[float]]
+    group: Callable[[Run], str]
+
+
+MATCHED = Basis("matched", "vs. the bounce-matched reference", lambda r: r.final.flip_mean,
+                lambda r: r.final.flip_sigma, lambda r: r.final.rel_mse,
+                lambda r: r.final.rel_mse_sigma, lambda r: r.reference_label())
+FULL = Basis("full", "vs. the full reference (all light paths)", lambda r: r.vs_full.flip_mean,
+             lambda r: r.vs_full.flip_sigma, lambda r: r.vs_full.rel_mse,
+             lambda r: r.vs_full.rel_mse_sigma, lambda r: "full")
+
+
+def ranking_basis(runs: list[Run]) -> Basis:
+    """FULL when any run has errors against the full reference, else MATCHED."""
+    return FULL if any(FULL.flip(r) is not None for r in runs if r.measured) else MATCHED
+
+
+def comparable_groups(runs: list[Run], basis: Basis,
+                      error: Optional[Callable[[Run], Optional[float]]] = None
+                      ) -> dict[str, list[Run]]:
+    """Ok runs with a frame time and an error, by the reference they were compared with (only
+    groups of at least MIN_COMPARED runs; fewest light paths first)."""
+    error = error or basis.flip
+    groups: dict[str, list[Run]] = {}
+    for run in runs:
+        if run.status == "ok" and run.frame_ms is not None and error(run) is not None:
+            groups.setdefault(basis.group(run), []).append(run)
+    return {label: members for label, members in sorted(groups.items(),
+                                                        key=lambda kv: (len(kv[0]), kv[0]))
+            if len(members) >= MIN_COMPARED}
+
+
+def pareto_fronts(runs: list[Run], basis: Basis,
+                  error: Optional[Callable[[Run], Optional[float]]] = None
+                  ) -> dict[str, list[Run]]:
+    """The Pareto front (of `error`, default the basis' mean FLIP) of each comparable group."""
+    error = error or basis.flip
+    return {label: pareto_front(members, error)
+            for label, members in comparable_groups(runs, basis, error).items()}
+
+
+def time_budgets(times: list[float]) -> list[float]:
+    """1-2-5 budgets [ms]: from the first one ≥ the fastest run to the first ≥ the slowest."""
+    if not times:
+        return []
+    low, high = min(times), max(times)
+    budgets: list[float] = []
+    decade = 10.0 ** math.floor(math.log10(low)) if low > 0 else 0.01
+    while not budgets or budgets[-1] < high:
+        for step in BUDGET_STEPS:
+            value = round(step * decade, 10)
+            if value >= low and (not budgets or budgets[-1] < high):
+                budgets.append(value)
+        decade *= 10.0
+        if len(budgets) > 60:
+            break
+    return budgets
+
+
+def error_targets(errors: list[float]) -> list[float]:
+    """Target errors: the ERROR_QUANTILES of the observed values, 2 significant digits, unique,
+    loosest first."""
+    if not errors:
+        return []
+    values = sorted(errors)
+    targets = []
+    for q in ERROR_QUANTILES:
+        position = q * (len(values) - 1)
+        lo = math.floor(position)
+        hi = min(lo + 1, len(values) - 1)
+        value = values[lo] + (values[hi] - values[lo]) * (position - lo)
+        targets.append(float(f"{value:.2g}"))
+    return sorted(set(targets), reverse=True)
+
+
+def best_within_budget(runs: list[Run], budget: float, basis: Basis) -> Optional[Run]:
+    """Lowest mean FLIP (of the basis) among the ok runs whose median frame time is ≤ budget."""
+    fits = [r for r in runs if r.status == "ok" and r.frame_ms is not None
+            and r.frame_ms <= budget and basis.flip(r) is not None]
+    return min(fits, key=lambda r: (basis.flip(r), r.frame_ms, r.key)) if fits else None
+
+
+def cheapest_reaching(runs: list[Run], target: float, basis: Basis) -> Optional[Run]:
+    """Fastest ok run whose mean FLIP (of the basis) is ≤ target."""
+    fits = [r for r in runs if r.status == "ok" and r.frame_ms is not None
+            and basis.flip(r) is not None and basis.flip(r) <= target]
+    return min(fits, key=lambda r: (r.frame_ms, basis.flip(r), r.key)) if fits else None
+
+
+@dataclass
+class Sweep:
+    """Runs of one technique on one scene that vary `key`; one series per value of the others."""
+
+    technique: str
+    scene: str
+    key: str
+    other_keys: list[str]
+    series: dict[tuple, list[Run]]  # values of other_keys -> runs sorted by the swept value
+    numeric: bool  # every value of `key` is a number
+
+
+def param_value(run: Run, key: str) -> object:
+    """The value of a swept parameter: the typed one from params, else the swept text."""
+    if key in run.params:
+        return run.params[key]
+    return run.swept.get(key)
+
+
+def sweep_x(run: Run, key: str) -> Optional[float]:
+    value = param_value(run, key)
+    if num(value) is not None:
+        return num(value)
+    try:
+        return float(text(value))
+    except ValueError:
+        return None
+
+
+def find_sweeps(runs: list[Run]) -> list[Sweep]:
+    """Every (technique, scene, swept key) whose measured runs take ≥ 2 values of that key."""
+    sweeps: list[Sweep] = []
+    groups: dict[tuple[str, str], list[Run]] = {}
+    for run in runs:
+        if run.measured and run.swept:
+            groups.setdefault((run.technique, run.scene), []).append(run)
+    for (tech, scene), group in sorted(groups.items()):
+        keys = ordered_unique([k for r in group for k in r.swept])
+        for key in keys:
+            values = {text(param_value(r, key)) for r in group}
+            if len(values) < 2:
+                continue
+            others = [k for k in keys if k != key]
+            numeric = all(sweep_x(r, key) is not None for r in group)
+            series: dict[tuple, list[Run]] = {}
+            for run in group:
+                series.setdefault(tuple(text(param_value(run, k)) for k in others), []).append(run)
+            for members in series.values():
+                members.sort(key=lambda r: (sweep_x(r, key) if numeric else 0.0,
+                                            text(param_value(r, key))))
+            ordered = dict(sorted(series.items(), key=lambda item: _series_order(item[0])))
+            sweeps.append(Sweep(tech, scene, key, others, ordered, numeric))
+    return sweeps
+
+
+def _series_order(values: tuple) -> tuple:
+    out = []
+    for v in values:
+        try:
+            out.append((0, float(v), ""))
+        except ValueError:
+            out.append((1, 0.0, v))
+    return tuple(out)
+
+
+def params_text(run: Run, only_swept: bool = False) -> str:
+    """'key=value, ...' with swept keys first."""
+    keys = ordered_unique(list(run.swept) + ([] if only_swept else list(run.params)))
+    return ", ".join(f"{k}={text(param_value(run, k))}" for k in keys)

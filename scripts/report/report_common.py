@@ -1,0 +1,157 @@
+"""Shared pieces of the report page: the Page context, number formatting and HTML helpers."""
+from __future__ import annotations
+
+import html
+import os
+import struct
+import urllib.parse
+from dataclasses import dataclass, field
+from typing import Callable, Optional
+
+from report_analysis import Basis, Sweep, ordered_unique, param_value, slug
+from report_data import Results, Run, dig, num, text
+
+DASH = "—"
+CARD_IMAGE_WIDTH = 200  # CSS px of each final / FLIP image in the scene cards
+REF_IMAGE_WIDTH = 200
+MIB = 1024.0 * 1024.0
+
+
+@dataclass
+class Figures:
+    """Paths (absolute) of the figures written for this page."""
+
+    pareto: dict[str, str] = field(default_factory=dict)  # scene -> svg
+    passes: dict[str, str] = field(default_factory=dict)  # scene -> svg
+    sweeps: list[tuple[Sweep, str]] = field(default_factory=list)
+
+
+@dataclass
+class Page:
+    """Everything a section needs."""
+
+    out_dir: str
+    results: Results
+    colors: dict[str, str]
+    figures: Figures
+    basis: Basis  # the errors runs are ranked by (fronts, equal-time tables)
+    bases: list[Basis]  # the rows of the error-vs-time figures
+    fronts: dict[str, dict[str, list[Run]]]  # scene -> comparable group -> front (mean FLIP)
+    docs_dir: Optional[str]
+    generated: str
+    tool_versions: str
+
+
+# ---------------------------------------------------------------------------------------------
+# Small helpers
+# ---------------------------------------------------------------------------------------------
+
+def esc(value: object) -> str:
+    return html.escape(text(value) if not isinstance(value, str) else value, quote=True)
+
+
+def rel_url(path: str, out_dir: str) -> str:
+    """A relative, percent-encoded URL from the page to a file ('#' in scene labels!)."""
+    rel = os.path.relpath(path, out_dir).replace(os.sep, "/")
+    return urllib.parse.quote(rel, safe="/._-~")
+
+
+def png_size(path: str) -> Optional[tuple[int, int]]:
+    """(width, height) from a PNG's IHDR, None if it is not a readable PNG."""
+    try:
+        with open(path, "rb") as f:
+            head = f.read(24)
+    except OSError:
+        return None
+    if len(head) < 24 or head[:8] != b"\x89PNG\r\n\x1a\n" or head[12:16] != b"IHDR":
+        return None
+    width, height = struct.unpack(">II", head[16:24])
+    return (width, height) if width > 0 and height > 0 else None
+
+
+def img_html(path: Optional[str], page: Page, alt: str, width: int, css: str = "",
+             lazy: bool = False) -> str:
+    """An <img> of a PNG shown `width` CSS px wide (linked to the full-size file), or a
+    placeholder naming the missing file."""
+    if not path or not os.path.isfile(path):
+        where = os.path.relpath(path, page.out_dir) if path else "no file recorded"
+        return f'<div class="missing">{esc(alt)}: image missing<br>{esc(where)}</div>'
+    size = png_size(path)
+    height = round(width * size[1] / size[0]) if size else width
+    classes = [css] if css else []
+    if size and size[0] < width:
+        classes.append("px")
+    url = rel_url(path, page.out_dir)
+    loading = ' loading="lazy"' if lazy else ""
+    return (f'<a href="{url}"><img src="{url}" alt="{esc(alt)}" title="{esc(alt)}" '
+            f'width="{width}" height="{height}" class="{" ".join(classes)}"{loading} '
+            f'onerror="gilabImageError(this)"></a>')
+
+
+def fmt_ms(x: Optional[float]) -> str:
+    if x is None:
+        return DASH
+    if abs(x) >= 100:
+        return f"{x:.0f}"
+    if abs(x) >= 10:
+        return f"{x:.1f}"
+    if abs(x) >= 1:
+        return f"{x:.2f}"
+    return f"{x:.3f}"
+
+
+def fmt_fixed(x: Optional[float], digits: int) -> str:
+    return DASH if x is None else f"{x:.{digits}f}"
+
+
+def fmt_sig(x: Optional[float], digits: int = 3) -> str:
+    return DASH if x is None else f"{x:.{digits}g}"
+
+
+def fmt_flip(x: Optional[float]) -> str:
+    return fmt_fixed(x, 4)
+
+
+def with_bar(value: str, sigma: Optional[float], fmt: Callable[[Optional[float]], str]) -> str:
+    if sigma is None or value == DASH:
+        return value
+    return f'{value} <span class="pm">± {fmt(sigma)}</span>'
+
+
+def swatch(tech: str, page: Page) -> str:
+    color = page.colors.get(tech, "#888")
+    return f'<span class="sw" style="background:{color}"></span>{esc(tech)}'
+
+
+def status_badge(status: str) -> str:
+    return f'<span class="badge st-{esc(status)}">{esc(status)}</span>'
+
+
+def params_html(run: Run) -> str:
+    """Swept parameters in bold, then the others."""
+    parts = []
+    for key in ordered_unique(list(run.swept) + list(run.params)):
+        item = f"{esc(key)}={esc(param_value(run, key))}"
+        parts.append(f"<b>{item}</b>" if key in run.swept else item)
+    return ", ".join(parts) if parts else f'<span class="muted">{DASH}</span>'
+
+
+def doc_link(page: Page, name: str) -> str:
+    """A link to docs/<name> when the repository's docs are found, else its name."""
+    if page.docs_dir and os.path.isfile(os.path.join(page.docs_dir, name)):
+        url = rel_url(os.path.join(page.docs_dir, name), page.out_dir)
+        return f'<a href="{url}"><code>docs/{esc(name)}</code></a>'
+    return f"<code>docs/{esc(name)}</code>"
+
+
+def nonfinite_count(run: Run) -> Optional[float]:
+    """NaN + Inf pixels of the final image (result.nonfinite.final), else the metric's count."""
+    layer = dig(run.data, "nonfinite", "final")
+    nan, inf = num(dig(layer, "nan_pixels")), num(dig(layer, "inf_pixels"))
+    if nan is not None or inf is not None:
+        return (nan or 0.0) + (inf or 0.0)
+    return run.final.test_nonfinite
+
+
+def scene_anchor(scene: str) -> str:
+    return "scene-" + slug(scene)

@@ -1,0 +1,517 @@
+"""The report's tables: the header, the run table, equal-time and equal-error tables, skipped
+passes, unreadable folders, definitions and provenance. Each function returns an HTML string, ""
+when the table applies to no run.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from typing import Callable, Optional
+
+from report_analysis import (MIN_COMPARED, best_within_budget, by_scene, by_technique,
+                             cheapest_reaching, comparable_groups, error_targets, ordered_unique,
+                             params_text, slug, time_budgets)
+from report_common import (DASH, MIB, Page, doc_link, esc, fmt_fixed, fmt_flip, fmt_ms, fmt_sig,
+                           nonfinite_count, params_html, status_badge, swatch, with_bar)
+from report_data import Results, Run, dig, num, text
+
+
+# ---------------------------------------------------------------------------------------------
+# Header
+# ---------------------------------------------------------------------------------------------
+
+def _counted(values: list[str]) -> str:
+    counts: dict[str, int] = {}
+    for v in values:
+        if v:
+            counts[v] = counts.get(v, 0) + 1
+    if not counts:
+        return DASH
+    return "; ".join(f"{esc(v)} <span class='muted'>({n} run{'s' if n != 1 else ''})</span>"
+                     for v, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+
+
+def _experiment_field(page: Page, name: str) -> list[str]:
+    return ordered_unique([text(e.get(name)) for e in page.results.experiments if e.get(name)])
+
+
+def experiment_name(results: Results) -> str:
+    names = ordered_unique([text(e.get("name")) for e in results.experiments if e.get("name")])
+    if not names:
+        names = ordered_unique([text(r.data.get("experiment")) for r in results.runs
+                                if r.data.get("experiment")])
+    if not names:
+        names = [os.path.basename(d.rstrip("/")) for d in results.dirs]
+    return " + ".join(names)
+
+
+def header_html(page: Page) -> str:
+    res = page.results
+    runs = res.runs
+    rows: list[tuple[str, str]] = []
+    descriptions = _experiment_field(page, "description")
+    dates = sorted(r.date for r in runs if r.date)
+    if dates:
+        rows.append(("runs dated", esc(dates[0]) if dates[0] == dates[-1]
+                     else f"{esc(dates[0])} … {esc(dates[-1])}"))
+    rows.append(("git commits", _counted([text(dig(r.data, "provenance", "git_commit"))
+                                          for r in runs])))
+    devices = []
+    for r in runs:
+        name = text(dig(r.data, "device", "name"))
+        driver = text(dig(r.data, "device", "driver_info")) or text(dig(r.data, "device", "driver"))
+        devices.append(f"{name} ({driver})" if name and driver else name)
+    rows.append(("devices", _counted(devices)))
+    rows.append(("hosts", _counted([text(dig(r.data, "provenance", "host")) for r in runs])))
+    configs = [f"{esc(p)}" for p in _experiment_field(page, "config_path")]
+    hashes = _experiment_field(page, "config_hash")
+    if configs or hashes:
+        rows.append(("config", ", ".join(configs) +
+                     (f" <span class='muted'>hash {esc(', '.join(hashes))}</span>"
+                      if hashes else "")
+                     + (" <b>(shards disagree on the config hash)</b>" if len(hashes) > 1 else "")))
+    overhead = _instrumentation(page)
+    if overhead:
+        rows.append(("timer overhead", overhead))
+    rows.append(("results", "<br>".join(esc(d) for d in res.dirs)))
+    rows.append(("runs", counts_html(page)))
+    meta = "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows)
+    desc = "".join(f'<p class="lead">{esc(d)}</p>' for d in descriptions)
+    return (f"<header><h1>gilab report — {esc(experiment_name(res))}</h1>{desc}"
+            f'<table class="meta">{meta}</table></header>')
+
+
+def _instrumentation(page: Page) -> str:
+    """experiment.json's measured cost of the timestamp queries (docs/timing.md, rule 6)."""
+    parts = []
+    for experiment in page.results.experiments:
+        probe = experiment.get("instrumentation")
+        if not isinstance(probe, dict):
+            continue
+        if probe.get("skipped"):
+            parts.append(f"not measured: {esc(probe.get('skipped'))}")
+            continue
+        ms, iqr = num(probe.get("overhead_ms")), num(probe.get("overhead_iqr_ms"))
+        if ms is not None:
+            parts.append(f"{with_bar(fmt_ms(ms), iqr, fmt_ms)} ms per frame "
+                         f"<span class='muted'>({esc(probe.get('technique'))} on "
+                         f"{esc(probe.get('scene'))}, CPU frame time with − without timestamp "
+                         "queries)</span>")
+    return "; ".join(ordered_unique(parts))
+
+
+def counts_html(page: Page) -> str:
+    res = page.results
+    parts = []
+    for status in ("ok", "nonfinite", "unsupported"):
+        n = sum(1 for r in res.runs if r.status == status)
+        parts.append(f"{status_badge(status)} {n}")
+    if res.unreadable:
+        parts.append(f'{status_badge("unreadable")} {len(res.unreadable)}')
+    totals = [num(e.get("runs_total")) for e in res.experiments]
+    totals = [int(t) for t in totals if t is not None]
+    found = len(res.runs) + len(res.unreadable)
+    total = f" of {max(totals)} configured" if totals else ""
+    extra = f" ({res.duplicates} duplicate{'s' if res.duplicates != 1 else ''} merged)" \
+        if res.duplicates else ""
+    return (f'<span class="counts"><b>{found}</b> run folders{total}{extra}: '
+            + " ".join(f"<span>{p}</span>" for p in parts) + "</span>")
+
+
+# ---------------------------------------------------------------------------------------------
+# Section 3: the run table
+# ---------------------------------------------------------------------------------------------
+
+@dataclass
+class Column:
+    id: str
+    title: str
+    tip: str
+    cell: Callable[[Run], tuple[str, object]]  # -> (inner HTML, sort value or None)
+    numeric: bool = True
+    css: str = "n"
+
+
+def _n(value: Optional[float], shown: str) -> tuple[str, object]:
+    return shown, value
+
+
+def _region_columns(runs: list[Run]) -> list[Column]:
+    names = ordered_unique([n for r in runs for n in r.regions])
+    return [Column(f"region_{slug(n)}", f"FLIP [{n}]", f"mean FLIP of the final image over the "
+                   f"region '{n}'",
+                   lambda r, n=n: _n(r.regions[n].flip_mean if n in r.regions else None,
+                                     fmt_flip(r.regions[n].flip_mean) if n in r.regions else DASH))
+            for n in names]
+
+
+def _passes_cell(run: Run) -> tuple[str, object]:
+    passes = run.passes()
+    if not passes:
+        return DASH, None
+    total = sum(v for _, v in passes if v is not None)
+    body = " · ".join(f'<span class="pass">{esc(n)}&nbsp;{fmt_ms(v)}</span>' for n, v in passes)
+    return body, total
+
+
+def _memory_cell(run: Run) -> tuple[str, object]:
+    total = num(dig(run.data, "memory", "total_bytes"))
+    peak = num(dig(run.data, "memory", "peak_bytes"))
+    if total is None:
+        return DASH, None
+    shown = f"{total / MIB:.1f}"
+    if peak is not None and peak > total:
+        shown += f' <span class="pm">peak {peak / MIB:.1f}</span>'
+    return shown, total
+
+
+def _frame_cell(run: Run) -> tuple[str, object]:
+    shown = with_bar(fmt_ms(run.frame_ms), run.frame_iqr, fmt_ms)
+    if run.frame_source == "cpu":
+        shown += ' <span class="pm">(CPU)</span>'
+    return shown, run.frame_ms
+
+
+def _status_cell(run: Run) -> tuple[str, object]:
+    shown = status_badge(run.status)
+    if run.reason:
+        shown += f'<div class="reason">{esc(run.reason)}</div>'
+    return shown, run.status
+
+
+def _noise_cell(run: Run) -> tuple[str, object]:
+    if not run.final.bars_available:
+        return DASH, None  # no error bars: the column is dropped when no run has them
+    hits = [name for name, hit in (("MSE", run.final.within_reference_noise),
+                                   ("FLIP", run.final.flip_within_noise)) if hit]
+    if not hits:
+        return "no", 0
+    return f'<span class="badge b-noise">{" + ".join(hits)}</span>', len(hits)
+
+
+def _reference_cell(run: Run) -> tuple[str, object]:
+    label = run.reference_label()
+    spp = num(dig(run.data, "reference", "samples"))
+    if not label and spp is None:
+        return DASH, None
+    shown = esc(label) + (f' <span class="pm">{int(spp)} spp</span>' if spp is not None else "")
+    return shown, label
+
+
+def _front_cell(run: Run, page: Page) -> tuple[str, object]:
+    on = any(run is r for front in page.fronts.get(run.scene, {}).values() for r in front)
+    return ('<span class="badge b-front">front</span>', 1) if on else ("", 0)
+
+
+def run_columns(page: Page) -> list[Column]:
+    """The run table's columns: identity, error, then cost; those no run has are dropped."""
+    runs = page.results.runs
+    cols = [
+        Column("index", "#", "run index in the experiment", lambda r: _n(r.index, text(r.index))),
+        Column("scene", "scene", "scene label", lambda r: (esc(r.scene), r.scene), False, ""),
+        Column("technique", "technique", "technique id",
+               lambda r: (swatch(r.technique, page), r.technique), False, ""),
+        Column("params", "parameters", "technique parameters (swept ones in bold)",
+               lambda r: (params_html(r), params_text(r)), False, "params"),
+        Column("status", "status", "ok / nonfinite / unsupported (with the reason)",
+               _status_cell, False, "reason"),
+        Column("frame", "frame [ms]", "median frame time over the timed frames ± IQR "
+               "(GPU: sum of pass timestamps)", _frame_cell),
+        Column("flip", "mean FLIP", "mean HDR-FLIP of the final image against the "
+               "bounce-matched reference (↓); ± 1σ from the reference's noise",
+               lambda r: _n(r.final.flip_mean, with_bar(fmt_flip(r.final.flip_mean),
+                                                         r.final.flip_sigma, fmt_flip))),
+        Column("relmse", "relMSE", "relative MSE of the linear images against the bounce-matched "
+               "reference (↓); ± 1σ",
+               lambda r: _n(r.final.rel_mse, with_bar(fmt_sig(r.final.rel_mse),
+                                                       r.final.rel_mse_sigma, fmt_sig))),
+        Column("psnr", "PSNR LDR [dB]", "PSNR of the tonemapped 8-bit images (↑); ± 1σ",
+               lambda r: _n(r.final.psnr_ldr, with_bar(fmt_fixed(r.final.psnr_ldr, 2),
+                                                        r.final.psnr_ldr_sigma,
+                                                        lambda x: fmt_fixed(x, 2)))),
+        Column("ssim", "SSIM", "SSIM of the tonemapped luma (↑)",
+               lambda r: _n(r.final.ssim, fmt_fixed(r.final.ssim, 4))),
+        Column("flip_full", "FLIP vs full", "mean HDR-FLIP against the full reference (all light "
+               "paths, whatever the technique claims) (↓)",
+               lambda r: _n(r.vs_full.flip_mean, fmt_flip(r.vs_full.flip_mean))),
+        Column("relmse_full", "relMSE vs full", "relMSE against the full reference (↓); ± 1σ",
+               lambda r: _n(r.vs_full.rel_mse, with_bar(fmt_sig(r.vs_full.rel_mse),
+                                                         r.vs_full.rel_mse_sigma, fmt_sig))),
+        *_region_columns(runs),
+        Column("flip_indirect", "FLIP indirect", "mean HDR-FLIP of the indirect layer against "
+               "the reference's indirect layer",
+               lambda r: _n(r.indirect.flip_mean, fmt_flip(r.indirect.flip_mean))),
+        Column("energy", "energy ratio", "mean luminance of the indirect layer over the "
+               "reference's (1 = the right amount of indirect light)",
+               lambda r: _n(r.energy_ratio, fmt_fixed(r.energy_ratio, 3))),
+        Column("nonfinite", "NaN/Inf px", "NaN or Inf pixels in the final image",
+               lambda r: _n(nonfinite_count(r), fmt_sig(nonfinite_count(r), 6))),
+        Column("noise", "within ref. noise", "whether the error is no larger than what the "
+               "reference's own Monte Carlo noise produces (MSE and/or FLIP)", _noise_cell, True,
+               ""),
+        Column("front", "Pareto", f"on its scene's Pareto front (mean FLIP {page.basis.caption} "
+               "vs. frame time)", lambda r: _front_cell(r, page), True, ""),
+        Column("setup", "set-up [ms]", "one-time set-up, CPU wall clock (timing.setup_ms.total)",
+               lambda r: _n(r.setup_ms, fmt_ms(r.setup_ms))),
+        Column("passes", "passes [ms]", "median GPU time of each pass (sorts by their sum)",
+               _passes_cell, True, "passes"),
+        Column("memory", "memory [MiB]", "GPU memory allocated by gilab (total; peak if higher)",
+               _memory_cell),
+        Column("reference", "reference", "light paths of the matched reference, samples per "
+               "pixel", _reference_cell, False, ""),
+    ]
+    return _applicable(cols, runs, page)
+
+
+def _applicable(cols: list[Column], runs: list[Run], page: Page) -> list[Column]:
+    """Drops the columns no run has a value for; 'Pareto' only when a front exists."""
+    always = {"index", "scene", "technique", "params", "status"}
+    keep = []
+    for c in cols:
+        if c.id == "front":
+            if any(page.fronts.values()):
+                keep.append(c)
+        elif c.id in always or any(c.cell(r)[1] not in (None, "") for r in runs):
+            keep.append(c)
+    return keep
+
+
+def run_table_html(page: Page) -> str:
+    runs = page.results.runs
+    if not runs:
+        return ""
+    cols = run_columns(page)
+    head = "".join(f'<th data-col="{c.id}" data-type="{"num" if c.numeric else "text"}" '
+                   f'title="{esc(c.tip)}">{esc(c.title)}</th>' for c in cols)
+    rows = []
+    for run in runs:
+        cells = []
+        for c in cols:
+            shown, value = c.cell(run)
+            sort = "" if value is None else (repr(float(value)) if c.numeric and
+                                             num(value) is not None else esc(value))
+            cells.append(f'<td class="c-{c.id} {c.css}" data-v="{sort}">{shown}</td>')
+        css = "run-row" + (" noise" if run.final.within_reference_noise else "")
+        rows.append(f'<tr class="{css}" data-key="{esc(run.key)}">{"".join(cells)}</tr>')
+    return ('<h2 id="runs">All runs</h2><p>Every finished run. Click a column header to sort '
+            '(click again to reverse); hover a header for its definition. Rows shaded green '
+            'have an error within the reference\'s noise.</p>'
+            '<div class="filter">filter <input id="run-filter" type="search" '
+            'placeholder="scene, technique, parameter, status…"> '
+            f'<span id="run-count" class="muted">{len(runs)} of {len(runs)}</span></div>'
+            f'<div class="table-wrap"><table id="run-table" class="data sortable"><thead><tr>'
+            f'{head}</tr></thead><tbody>{"".join(rows)}</tbody></table></div>')
+
+
+def failures_html(page: Page) -> str:
+    bad = [r for r in page.results.runs if r.status in ("unsupported", "nonfinite")]
+    if not bad:
+        return ""
+    items = []
+    for run in bad:
+        if run.status == "unsupported":
+            why = esc(run.reason) or "no reason recorded"
+        else:
+            count = nonfinite_count(run)
+            why = (f"{int(count)} NaN/Inf pixels in the final image" if count
+                   else "non-finite values in an output layer") + \
+                "; its metrics cover the finite pixels only"
+        items.append(f"<li>{status_badge(run.status)} {swatch(run.technique, page)} on "
+                     f"{esc(run.scene)} ({esc(params_text(run, True)) or 'no swept parameter'})"
+                     f": {why}</li>")
+    return ('<h3 id="failures">Where techniques break</h3><ul>' + "".join(items) + "</ul>")
+
+
+# ---------------------------------------------------------------------------------------------
+# Section 7: equal-time and equal-error tables
+# ---------------------------------------------------------------------------------------------
+
+def _equal_table(page: Page, runs: list[Run], headers: list[str],
+                 pick: Callable[[list[Run], int], Optional[Run]],
+                 show: Callable[[Run], str], value: Callable[[Run], float]) -> str:
+    techs = by_technique([r for r in runs if r.status == "ok"])
+    winners: dict[int, float] = {}
+    picks: dict[str, list[Optional[Run]]] = {}
+    for tech, tech_runs in techs.items():
+        picks[tech] = [pick(tech_runs, i) for i in range(len(headers))]
+        for i, run in enumerate(picks[tech]):
+            if run is not None and (i not in winners or value(run) < winners[i]):
+                winners[i] = value(run)
+    rows = []
+    for tech, chosen in picks.items():
+        cells = []
+        for i, run in enumerate(chosen):
+            if run is None:
+                cells.append(f'<td class="n">{DASH}</td>')
+                continue
+            best = " best" if value(run) == winners.get(i) else ""
+            cells.append(f'<td class="n{best}" title="{esc(params_text(run))}">{show(run)}</td>')
+        rows.append(f"<tr><td>{swatch(tech, page)}</td>{''.join(cells)}</tr>")
+    head = "".join(f'<th>{h}</th>' for h in headers)
+    return (f'<table class="data"><thead><tr><th>technique</th>{head}</tr></thead>'
+            f'<tbody>{"".join(rows)}</tbody></table>')
+
+
+def _equal_group_html(page: Page, ok: list[Run]) -> str:
+    """The equal-time and equal-error tables of runs compared with one reference."""
+    basis = page.basis
+    budgets = time_budgets([r.frame_ms for r in ok])
+    targets = error_targets([basis.flip(r) for r in ok])
+    return ("<h4>Equal time: lowest mean FLIP within a frame-time budget</h4>"
+            + _equal_table(page, ok, [f"≤ {b:g} ms" for b in budgets],
+                           lambda rs, i: best_within_budget(rs, budgets[i], basis),
+                           lambda r: fmt_flip(basis.flip(r)), basis.flip)
+            + "<h4>Equal error: shortest frame time reaching a mean FLIP</h4>"
+            + _equal_table(page, ok, [f"FLIP ≤ {t:g}" for t in targets],
+                           lambda rs, i: cheapest_reaching(rs, targets[i], basis),
+                           lambda r: fmt_ms(r.frame_ms) + " ms", lambda r: r.frame_ms))
+
+
+def _left_out_note(runs: list[Run], groups: dict[str, list[Run]], page: Page) -> str:
+    left_out = sorted({r.technique for r in runs if r.measured}
+                      - {r.technique for g in groups.values() for r in g})
+    if not left_out:
+        return ""
+    return (f'<p class="note">not in this comparison (no ok run with a time and an error, or '
+            f'fewer than {MIN_COMPARED} runs compared with its reference): '
+            + ", ".join(swatch(t, page) for t in left_out) + "</p>")
+
+
+def equal_html(page: Page) -> str:
+    parts = []
+    for scene, runs in by_scene(page.results.runs).items():
+        groups = comparable_groups(runs, page.basis)
+        if not groups:
+            continue
+        parts.append(f"<h3>{esc(scene)}</h3>")
+        for label, ok in groups.items():
+            if page.basis.name == "matched":
+                parts.append(f'<p class="note">runs compared with the reference <b>{esc(label)}'
+                             '</b></p>')
+            parts.append(_equal_group_html(page, ok))
+        parts.append(_left_out_note(runs, groups, page))
+    if not parts:
+        return ""
+    among = ("every run of a scene, with mean FLIP against the full reference (all light paths)"
+             if page.basis.name == "full" else
+             "the runs of a scene compared with the same bounce-matched reference")
+    return ('<h2 id="equal">Equal-time and equal-error comparison</h2><p>Among ' + among +
+            '. Budgets are the 1-2-5 series of milliseconds covering the observed median frame '
+            'times; target errors are the 90/75/50/25/10 % quantiles of the observed mean FLIP '
+            'values (2 significant digits). Each cell is the technique\'s best ok run under that '
+            'constraint (hover for its parameters); the best technique in each column is '
+            f'highlighted; {DASH} = no run qualifies.</p>' + "".join(parts))
+
+
+# ---------------------------------------------------------------------------------------------
+# Section 8: skipped passes and notes; unreadable folders
+# ---------------------------------------------------------------------------------------------
+
+def _grouped_lists_table(page: Page, field_name: str, title: str) -> str:
+    groups: dict[tuple, list[Run]] = {}
+    for run in page.results.runs:
+        values = run.data.get(field_name)
+        items = tuple(text(v) for v in values) if isinstance(values, list) else ()
+        if items:
+            groups.setdefault(items, []).append(run)
+    if not groups:
+        return ""
+    rows = []
+    for items, runs in groups.items():
+        listing = "".join(f"<li>{_pass_and_reason(i)}</li>" for i in items)
+        techs = ", ".join(swatch(t, page) for t in ordered_unique([r.technique for r in runs]))
+        scenes = ", ".join(esc(s) for s in ordered_unique([r.scene for r in runs]))
+        rows.append(f'<tr><td><ul class="skipped">{listing}</ul></td><td class="n">{len(runs)}'
+                    f"</td><td>{techs}</td><td>{scenes}</td></tr>")
+    return (f"<h3>{title}</h3><table class='data'><thead><tr><th>{title.lower()}</th><th>runs"
+            "</th><th>techniques</th><th>scenes</th></tr></thead><tbody>" + "".join(rows) +
+            "</tbody></table>")
+
+
+def _pass_and_reason(item: str) -> str:
+    name, sep, reason = item.partition(": ")
+    return f"<code>{esc(name)}</code>: {esc(reason)}" if sep else esc(item)
+
+
+def skipped_html(page: Page) -> str:
+    skipped = _grouped_lists_table(page, "skipped_passes", "Skipped passes")
+    notes = _grouped_lists_table(page, "notes", "Notes")
+    if not skipped and not notes:
+        return ""
+    return ('<h2 id="skipped">Skipped passes and notes</h2><p>Runs grouped by identical lists. '
+            'A skipped pass did not run (and cost nothing) for the reason given.</p>'
+            + skipped + notes)
+
+
+def unreadable_html(page: Page) -> str:
+    bad = page.results.unreadable
+    if not bad:
+        return ""
+    rows = "".join(f"<tr><td>{status_badge('unreadable')}</td><td><code>{esc(u.path)}</code>"
+                   f"</td><td>{esc(u.why)}</td></tr>" for u in bad)
+    return ('<h2 id="unreadable">Unreadable run folders</h2><p>These run folders have no usable '
+            'result.json; they are not in any table or figure.</p><table class="data"><thead><tr>'
+            '<th>status</th><th>path</th><th>problem</th></tr></thead><tbody>' + rows +
+            "</tbody></table>")
+
+
+# ---------------------------------------------------------------------------------------------
+# Section 10: definitions and provenance
+# ---------------------------------------------------------------------------------------------
+
+def footer_html(page: Page) -> str:
+    definitions = [
+        ("Frame time", "median over the timed frames (warm-up frames discarded) of the GPU frame "
+         "time, the sum of the per-pass timestamp intervals; ± is the interquartile range "
+         "(q3 − q1). Runs without GPU timings use the CPU frame time, marked (CPU). See "
+         + doc_link(page, "timing.md") + "."),
+        ("Set-up time", "CPU wall clock of the one-time set-up (scene upload, shared passes, "
+         "shadow maps, technique set-up), <code>timing.setup_ms.total</code>."),
+        ("Memory", "bytes of GPU memory allocated through gilab's accounting, in MiB "
+         "(2<sup>20</sup> bytes); the peak is shown when higher than the final total."),
+        ("Errors", "mean FLIP, relMSE, PSNR (LDR) and SSIM of the final image against the "
+         "path-traced reference with the light paths the technique claims (emission, direct and "
+         "its number of indirect bounces: the <i>bounce-matched</i> reference); the columns "
+         "\u201cvs full\u201d against the <i>full</i> reference (all light paths). relMSE on "
+         "linear values, PSNR (LDR) and SSIM on the tonemapped 8-bit images, FLIP is HDR-FLIP. "
+         "Definitions in " + doc_link(page, "metrics.md") + ". Error bars (±1σ) come from "
+         "re-sampling the reference's per-pixel standard error. <i>Within the reference's "
+         "noise</i>: MSE ≤ 2 × the reference's noise floor (MSE), or FLIP ≤ the FLIP of a "
+         "noise-only image + 2 of its standard deviations (FLIP)."),
+        ("Best run", "per technique and scene: the ok run with the lowest mean FLIP against the "
+         "bounce-matched reference (ties: lower relMSE, then shorter frame time)."),
+        ("Ranking", f"fronts and equal-time/error tables use the mean FLIP "
+         f"{esc(page.basis.caption)}, among the ok runs of one scene compared with the same "
+         "reference (at least two runs)."),
+        ("Pareto front", "the runs for which no other run has both a frame time ≤ and an error "
+         "<."),
+        ("Equal time / equal error", "equal time: for each budget B, the lowest mean FLIP among "
+         "the technique's runs with median frame time ≤ B (budgets: the 1-2-5 series of ms "
+         "covering the observed times). Equal error: for each target E, the shortest median "
+         "frame time among its runs with mean FLIP ≤ E (targets: the 90/75/50/25/10 % quantiles "
+         "of the observed values)."),
+        ("Report", f"generated {esc(page.generated)} by <code>scripts/report/make_report.py"
+         f"</code> ({esc(page.tool_versions)}); described in " + doc_link(page, "report.md")
+         + "."),
+    ]
+    items = "".join(f"<dt>{k}</dt><dd>{v}</dd>" for k, v in definitions)
+    return f'<footer><h2 id="definitions">Definitions and provenance</h2><dl>{items}</dl>' \
+           f'{provenance_html(page)}</footer>'
+
+
+def provenance_html(page: Page) -> str:
+    keys = ("git_commit", "gilab_version", "build_type", "compiler", "host", "cpu")
+    seen: dict[tuple, int] = {}
+    for run in page.results.runs:
+        prov = run.data.get("provenance") if isinstance(run.data.get("provenance"), dict) else {}
+        row = tuple(text(prov.get(k)) for k in keys) + (
+            text(dig(run.data, "device", "name")), text(dig(run.data, "device", "driver_info")),
+            text(dig(run.data, "device", "vulkan_api")))
+        seen[row] = seen.get(row, 0) + 1
+    if not seen:
+        return ""
+    head = "".join(f"<th>{h}</th>" for h in keys + ("device", "driver", "Vulkan", "runs"))
+    rows = "".join("<tr>" + "".join(f"<td>{esc(v) or DASH}</td>" for v in row)
+                   + f"<td class='n'>{n}</td></tr>" for row, n in seen.items())
+    return (f'<h3>Provenance</h3><div class="table-wrap"><table class="data"><thead><tr>{head}'
+            f'</tr></thead><tbody>{rows}</tbody></table></div>')

@@ -1,0 +1,523 @@
+// The reference cache: key stability, atomic store/load, corruption, continuation and
+// `gilab reference` end to end (docs/reference_cache.md). Tiny images, few samples.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <set>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/image/image_io.h"
+#include "core/scene/scene_loader.h"
+#include "core/util/error.h"
+#include "experiments/cli/cli.h"
+#include "experiments/cli/interrupt.h"
+#include "reference/bench.h"
+#include "reference/cache.h"
+#include "reference/scene_hash.h"
+
+namespace gilab {
+namespace {
+namespace fs = std::filesystem;
+
+Scene tinyScene() {
+    Scene scene = makeBuiltinDefaultScene();
+    scene.settings.width = 12;
+    scene.settings.height = 10;
+    return scene;
+}
+
+ref::ReferenceSettings tinySettings() {
+    ref::ReferenceSettings s;
+    s.maxBounces = 2;
+    s.batchSamples = 4;
+    return s;
+}
+
+ref::StopCriteria samplesStop(uint64_t n) {
+    return ref::StopCriteria{n, 0.0, 0.0};
+}
+
+/** A fresh folder per test, removed afterwards. */
+class TempDir {
+public:
+    TempDir() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        m_path = fs::temp_directory_path() / ("gilab_refcache_" + std::to_string(::getpid()) + "_" +
+                                              info->test_suite_name() + "_" + info->name());
+        fs::remove_all(m_path);
+        fs::create_directories(m_path);
+    }
+    ~TempDir() {
+        std::error_code ec;
+        fs::remove_all(m_path, ec);
+    }
+    const fs::path& path() const { return m_path; }
+
+private:
+    fs::path m_path;
+};
+
+/** A synthetic accumulator with irregular values (no rendering). */
+ref::Accumulator syntheticAccumulator(int w, int h, uint64_t samples) {
+    ref::Accumulator acc;
+    acc.reset(w, h);
+    acc.samples = samples;
+    acc.nonFiniteSamples = 3;
+    for (size_t i = 0; i < acc.sum.size(); ++i) {
+        acc.sum[i] = double(i) * 0.1234567 + 1.0 / double(i + 3);
+        acc.sumSq[i] = acc.sum[i] * acc.sum[i] * 1.5 + 1e-9 * double(i);
+    }
+    return acc;
+}
+
+nlohmann::ordered_json minimalSidecar(const std::string& key, const ref::Accumulator& acc,
+                                      const char* status = "complete") {
+    return {{"status", status}, {"key", key}, {"samples", acc.samples}};
+}
+
+bool bitEqual(const ref::Accumulator& a, const ref::Accumulator& b) {
+    return a.width == b.width && a.height == b.height && a.samples == b.samples &&
+           a.nonFiniteSamples == b.nonFiniteSamples && a.sum.size() == b.sum.size() &&
+           a.sumSq.size() == b.sumSq.size() &&
+           std::memcmp(a.sum.data(), b.sum.data(), a.sum.size() * sizeof(double)) == 0 &&
+           std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0;
+}
+
+std::string errorOf(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+
+nlohmann::json readJson(const fs::path& path) {
+    std::ifstream in(path);
+    return nlohmann::json::parse(in);
+}
+
+const std::string kKey = std::string(32, 'a');
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Key
+
+TEST(CpuReferenceKey, SameInputGivesSameKey) {
+    const std::string a = ref::referenceKey(tinyScene(), tinySettings());
+    const std::string b = ref::referenceKey(tinyScene(), tinySettings());
+    EXPECT_EQ(a, b);
+    EXPECT_EQ(a.size(), 32u);
+    EXPECT_EQ(a.find_first_not_of("0123456789abcdef"), std::string::npos);
+}
+
+TEST(CpuReferenceKey, EveryImageInputChangesTheKey) {
+    using Edit = std::function<void(Scene&, ref::ReferenceSettings&)>;
+    const std::vector<std::pair<const char*, Edit>> edits = {
+        {"light intensity", [](Scene& s, auto&) { s.lights.push_back(Light{}); }},
+        {"material colour", [](Scene& s, auto&) { s.materials[0].baseColorFactor.r *= 0.5f; }},
+        {"emission", [](Scene& s, auto&) { s.materials.back().emissiveFactor.g += 1.0f; }},
+        {"camera position", [](Scene& s, auto&) { s.camera.position.x += 1e-3f; }},
+        {"camera fov", [](Scene& s, auto&) { s.camera.vfovRad *= 1.01f; }},
+        {"resolution", [](Scene& s, auto&) { s.settings.width += 1; }},
+        {"vertex", [](Scene& s, auto&) { s.vertices[0].position.y += 1e-4f; }},
+        {"triangle material", [](Scene& s, auto&) { s.triangleMaterials[0] ^= 1u; }},
+        {"max bounces", [](Scene&, auto& r) { r.maxBounces += 1; }},
+        {"roulette", [](Scene&, auto& r) { r.rouletteStartBounce = 3; }},
+        {"estimator", [](Scene&, auto& r) { r.estimator = ref::Estimator::NeeOnly; }},
+        {"seed", [](Scene&, auto& r) { r.seed += 1; }},
+    };
+    std::set<std::string> keys = {ref::referenceKey(tinyScene(), tinySettings())};
+    for (const auto& [what, edit] : edits) {
+        Scene scene = tinyScene();
+        ref::ReferenceSettings settings = tinySettings();
+        edit(scene, settings);
+        EXPECT_TRUE(keys.insert(ref::referenceKey(scene, settings)).second) << what;
+    }
+    // A light's intensity alone
+    Scene withLight = tinyScene();
+    withLight.lights.push_back(Light{});
+    const std::string before = ref::referenceKey(withLight, tinySettings());
+    withLight.lights.back().intensity.b = 2.0f;
+    EXPECT_NE(ref::referenceKey(withLight, tinySettings()), before);
+}
+
+TEST(CpuReferenceKey, BatchSamplesNamesAndExposureKeepTheKey) {
+    const std::string base = ref::referenceKey(tinyScene(), tinySettings());
+    ref::ReferenceSettings settings = tinySettings();
+    settings.batchSamples = 16;
+    EXPECT_EQ(ref::referenceKey(tinyScene(), settings), base);
+    Scene scene = tinyScene();
+    scene.name = "renamed";
+    scene.materials[0].name = "renamed";
+    scene.settings.exposureEv = 2.0f;
+    EXPECT_EQ(ref::referenceKey(scene, tinySettings()), base);
+}
+
+TEST(CpuReferenceKey, LoadedFileBytesChangeTheKey) {
+    TempDir tmp;
+    const fs::path file = tmp.path() / "mesh.bin";
+    std::ofstream(file, std::ios::binary) << "0123456789";
+    Scene scene = tinyScene();
+    scene.loadedFiles.push_back(file.string());
+    const ref::ReferenceKey a = ref::computeReferenceKey(scene, tinySettings());
+    EXPECT_EQ(ref::referenceKey(scene, tinySettings()), a.hex);
+    std::ofstream(file, std::ios::binary) << "0123456780";  // same size, one byte differs
+    EXPECT_NE(ref::referenceKey(scene, tinySettings()), a.hex);
+    ASSERT_EQ(a.description["files"].size(), 1u);
+    EXPECT_EQ(a.description["files"][0]["bytes"], 10);
+    EXPECT_EQ(a.description["settings"]["max_bounces"], 2);
+
+    fs::remove(file);
+    const std::string message = errorOf([&] { ref::referenceKey(scene, tinySettings()); });
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+}
+
+TEST(CpuReferenceKey, SceneFilesAndVariantsHaveTheirOwnKeys) {
+    const std::string path = std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json";
+    const Scene base = loadSceneFile(path);
+    const Scene spot = loadSceneFile(path, "spot");
+    const ref::ReferenceKey a = ref::computeReferenceKey(base, tinySettings());
+    EXPECT_NE(a.hex, ref::referenceKey(spot, tinySettings()));
+    EXPECT_EQ(a.description["files"].size(), base.loadedFiles.size());
+    // The built-in box is the same image as cornell_box.json; only the file bytes differ
+    EXPECT_EQ(ref::hashSceneData(base), ref::hashSceneData(makeBuiltinDefaultScene()));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Store and load
+
+TEST(CpuReferenceCache, AccumulatorRoundTripIsBitExact) {
+    TempDir tmp;
+    const ref::Accumulator acc = syntheticAccumulator(5, 3, 17);
+    ref::writeAccumulatorFile(tmp.path() / "a.bin", acc);
+    EXPECT_TRUE(bitEqual(ref::readAccumulatorFile(tmp.path() / "a.bin"), acc));
+
+    const ref::ReferenceCache cache(tmp.path() / "cache");
+    EXPECT_FALSE(cache.load(kKey).has_value());
+    cache.store(kKey, acc, minimalSidecar(kKey, acc));
+    const auto loaded = cache.load(kKey);
+    ASSERT_TRUE(loaded.has_value());
+    EXPECT_TRUE(bitEqual(loaded->acc, acc));
+    EXPECT_TRUE(loaded->complete);
+    EXPECT_EQ(loaded->dir, cache.entryDir(kKey));
+    const std::vector<ImageLayer> layers = readExrLayers((loaded->dir / "reference.exr").string());
+    ASSERT_EQ(layers.size(), size_t(2 * ref::kLayerCount));
+    EXPECT_EQ(layers[0].name, "full");
+    EXPECT_EQ(layers[ref::kLayerCount].name, "full_stderr");
+}
+
+TEST(CpuReferenceCache, StoreReplacesAnEntryAndLeavesNoTemporaries) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    cache.store(kKey, syntheticAccumulator(4, 4, 4),
+                minimalSidecar(kKey, syntheticAccumulator(4, 4, 4), "partial"));
+    EXPECT_FALSE(cache.load(kKey)->complete);
+    const ref::Accumulator eight = syntheticAccumulator(4, 4, 8);
+    cache.store(kKey, eight, minimalSidecar(kKey, eight));
+    EXPECT_TRUE(bitEqual(cache.load(kKey)->acc, eight));
+    for (const auto& e : fs::directory_iterator(tmp.path()))
+        EXPECT_EQ(e.path().filename().string(), kKey);
+}
+
+TEST(CpuReferenceCache, CorruptAccumulatorIsDetectedNamingTheFile) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    const ref::Accumulator acc = syntheticAccumulator(6, 5, 9);
+    const fs::path file = cache.entryDir(kKey) / "accumulator.bin";
+    auto freshEntry = [&] { cache.store(kKey, acc, minimalSidecar(kKey, acc)); };
+    auto flipByte = [&](std::streamoff offset) {
+        std::fstream f(file, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekg(offset);
+        char c = 0;
+        f.get(c);
+        f.seekp(offset);
+        f.put(char(c ^ 0x10));
+    };
+    const std::streamoff size = std::streamoff(fs::file_size((freshEntry(), file)));
+    for (std::streamoff offset :
+         {std::streamoff(0), std::streamoff(20), std::streamoff(100), size - 20, size - 1}) {
+        freshEntry();
+        flipByte(offset);
+        const std::string message = errorOf([&] { cache.load(kKey); });
+        EXPECT_NE(message.find(file.string()), std::string::npos) << offset << ": " << message;
+    }
+    freshEntry();
+    fs::resize_file(file, fs::file_size(file) - 8);
+    std::string message = errorOf([&] { cache.load(kKey); });
+    EXPECT_NE(message.find(file.string()), std::string::npos) << message;
+    EXPECT_NE(message.find("truncated"), std::string::npos) << message;
+
+    // A sidecar that disagrees with the accumulator is corrupt too
+    freshEntry();
+    nlohmann::ordered_json sidecar = minimalSidecar(kKey, acc);
+    sidecar["samples"] = 10;
+    std::ofstream(cache.entryDir(kKey) / "reference.json") << sidecar.dump();
+    message = errorOf([&] { cache.load(kKey); });
+    EXPECT_NE(message.find("reference.json"), std::string::npos) << message;
+    EXPECT_NE(errorOf([&] { cache.entryDir("../escape"); }), "");
+}
+
+TEST(CpuReferenceCache, TemporaryFoldersAreNeverLoadedAndStaleOnesAreCleaned) {
+    TempDir tmp;
+    const ref::ReferenceCache source(tmp.path() / "source");
+    const ref::Accumulator acc = syntheticAccumulator(3, 3, 4);
+    source.store(kKey, acc, minimalSidecar(kKey, acc));
+    // A crash after writing everything but before the rename: a complete-looking .tmp folder
+    const ref::ReferenceCache cache(tmp.path() / "cache");
+    fs::create_directories(cache.dir());
+    const fs::path stale = cache.dir() / (".tmp-" + kKey + "-999999-0");
+    const fs::path recent = cache.dir() / (".tmp-" + kKey + "-999998-0");
+    fs::copy(source.entryDir(kKey), stale);
+    fs::copy(source.entryDir(kKey), recent);
+    EXPECT_FALSE(cache.load(kKey).has_value());
+
+    fs::last_write_time(stale, fs::file_time_type::clock::now() - std::chrono::hours(25));
+    const std::string other = std::string(32, 'b');
+    cache.store(other, acc, minimalSidecar(other, acc));
+    EXPECT_FALSE(fs::exists(stale));
+    EXPECT_TRUE(fs::exists(recent));  // may belong to a running process
+    EXPECT_FALSE(cache.load(kKey).has_value());
+}
+
+// ---------------------------------------------------------------------------------------------
+// obtainReference
+
+TEST(CpuObtainReference, SecondIdenticalRequestRendersNothing) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    const ref::ReferenceResult first =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(8), &cache);
+    EXPECT_FALSE(first.cacheHit);
+    EXPECT_EQ(first.renderedSamples, 8u);
+    EXPECT_EQ(first.sidecar["status"], "complete");
+    EXPECT_EQ(first.sidecar["samples"], 8);
+
+    const ref::ReferenceResult second =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(8), &cache);
+    EXPECT_TRUE(second.cacheHit);
+    EXPECT_EQ(second.renderedSamples, 0u);
+    EXPECT_EQ(second.report.rays.totalRays(), 0u);
+    EXPECT_TRUE(bitEqual(second.acc, first.acc));
+
+    // Fewer samples, a time budget, or a looser error target are met by the stored entry
+    EXPECT_TRUE(ref::obtainReference(tinyScene(), tinySettings(), samplesStop(4), &cache).cacheHit);
+    EXPECT_TRUE(
+        ref::obtainReference(tinyScene(), tinySettings(), ref::StopCriteria{0, 0.0, 5.0}, &cache)
+            .cacheHit);
+    EXPECT_TRUE(
+        ref::obtainReference(tinyScene(), tinySettings(), ref::StopCriteria{0, 1e6, 0.0}, &cache)
+            .cacheHit);
+    EXPECT_THROW(ref::obtainReference(tinyScene(), tinySettings(), ref::StopCriteria{}, &cache),
+                 Error);
+}
+
+TEST(CpuObtainReference, MoreSamplesContinueAndEqualAFreshRender) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    ref::obtainReference(tinyScene(), tinySettings(), samplesStop(8), &cache);
+    ref::ReferenceSettings finer = tinySettings();
+    finer.batchSamples = 2;  // same key: batching does not change the image
+    const ref::ReferenceResult more =
+        ref::obtainReference(tinyScene(), finer, samplesStop(20), &cache);
+    EXPECT_FALSE(more.cacheHit);
+    EXPECT_EQ(more.continuedFromSamples, 8u);
+    EXPECT_EQ(more.renderedSamples, 12u);
+    EXPECT_EQ(more.acc.samples, 20u);
+    EXPECT_EQ(more.sidecar["history"].size(), 2u);
+
+    const ref::ReferenceResult fresh =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(20), nullptr);
+    EXPECT_EQ(fresh.continuedFromSamples, 0u);
+    EXPECT_TRUE(bitEqual(more.acc, fresh.acc));
+    EXPECT_TRUE(bitEqual(cache.load(more.key)->acc, fresh.acc));
+}
+
+TEST(CpuObtainReference, CancelledRenderIsStoredPartialAndContinued) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    ref::ReferenceResult partial;
+    for (int attempt = 0; attempt < 5 && partial.acc.samples == 0; ++attempt) {
+        std::atomic<bool> cancel{false};
+        std::thread canceller([&] {
+            std::this_thread::sleep_for(std::chrono::milliseconds(50 << attempt));
+            cancel = true;
+        });
+        partial = ref::obtainReference(tinyScene(), tinySettings(), samplesStop(1u << 30), &cache,
+                                       ref::ObtainOptions{&cancel});
+        canceller.join();
+        EXPECT_EQ(partial.reason, ref::StopReason::Cancelled);
+    }
+    const uint64_t n = partial.acc.samples;
+    ASSERT_GT(n, 0u);
+    EXPECT_EQ(n % 4, 0u);  // a batch boundary
+    EXPECT_FALSE(partial.complete);
+    const auto stored = cache.load(partial.key);
+    ASSERT_TRUE(stored.has_value());
+    EXPECT_FALSE(stored->complete);
+    EXPECT_EQ(stored->sidecar["stop_reason"], "cancelled");
+    EXPECT_EQ(stored->acc.samples, n);
+
+    // A partial entry never meets a time budget: it is continued
+    const ref::ReferenceResult timed = ref::obtainReference(
+        tinyScene(), tinySettings(), ref::StopCriteria{n + 8, 0.0, 30.0}, &cache);
+    EXPECT_FALSE(timed.cacheHit);
+    EXPECT_EQ(timed.continuedFromSamples, n);
+    EXPECT_EQ(timed.acc.samples, n + 8);
+    EXPECT_TRUE(cache.load(timed.key)->complete);
+    const ref::ReferenceResult fresh =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(n + 8), nullptr);
+    EXPECT_TRUE(bitEqual(timed.acc, fresh.acc));
+}
+
+TEST(CpuObtainReference, CorruptEntryIsRenderedAgainWithAWarning) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    const ref::ReferenceResult first =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(4), &cache);
+    fs::resize_file(cache.entryDir(first.key) / "accumulator.bin", 100);
+    const ref::ReferenceResult again =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(4), &cache);
+    EXPECT_FALSE(again.cacheHit);
+    ASSERT_EQ(again.warnings.size(), 1u);
+    EXPECT_NE(again.warnings[0].find("accumulator.bin"), std::string::npos);
+    EXPECT_TRUE(bitEqual(again.acc, first.acc));
+    EXPECT_TRUE(bitEqual(cache.load(first.key)->acc, first.acc));
+}
+
+// ---------------------------------------------------------------------------------------------
+// `gilab reference`
+
+TEST(CpuReferenceCommand, WritesOutputsAndReusesTheCache) {
+    TempDir tmp;
+    cli::ReferenceOptions o;
+    o.spp = 8;
+    o.maxBounces = 2;
+    o.resolution = "12x10";
+    o.cacheDir = (tmp.path() / "cache").string();
+    o.outDir = (tmp.path() / "out").string();
+    o.quiet = true;
+    o.commandLine = "gilab reference --spp 8";
+    ASSERT_EQ(cli::runReference(o), cli::kExitOk);
+    const fs::path out = tmp.path() / "out";
+    for (const char* f : {"reference.exr", "reference.png", "reference.json"})
+        EXPECT_TRUE(fs::exists(out / f)) << f;
+    nlohmann::json j = readJson(out / "reference.json");
+    EXPECT_EQ(j["status"], "complete");
+    EXPECT_EQ(j["samples"], 8);
+    EXPECT_EQ(j["stop_reason"], "samples");
+    EXPECT_EQ(j["cache"]["hit"], false);
+    EXPECT_EQ(j["cache"]["continued_from_samples"], 0);
+    const std::string key = j["cache"]["key"];
+    EXPECT_EQ(key, j["key"]);
+    EXPECT_TRUE(fs::exists(tmp.path() / "cache" / key / "accumulator.bin"));
+    EXPECT_EQ(j["provenance"]["command_line"], "gilab reference --spp 8");
+    EXPECT_EQ(j["scene"]["resolution"][0], 12);
+    EXPECT_EQ(j["settings"]["max_bounces"], 2);
+    EXPECT_EQ(j["key_description"]["key"], key);
+    EXPECT_TRUE(j["renderer"]["tracer"].is_string());
+    EXPECT_TRUE(j["rel_error"].is_number());
+    EXPECT_EQ(j["nonfinite_samples"], 0);
+    const auto layers = readExrLayers((out / "reference.exr").string());
+    ASSERT_EQ(layers.size(), size_t(2 * ref::kLayerCount));
+    EXPECT_EQ(layers[0].image.width(), 12);
+
+    ASSERT_EQ(cli::runReference(o), cli::kExitOk);
+    j = readJson(out / "reference.json");
+    EXPECT_EQ(j["cache"]["hit"], true);
+    EXPECT_EQ(j["cache"]["rendered_samples"], 0);
+
+    o.spp = 12;
+    ASSERT_EQ(cli::runReference(o), cli::kExitOk);
+    j = readJson(out / "reference.json");
+    EXPECT_EQ(j["cache"]["hit"], false);
+    EXPECT_EQ(j["cache"]["continued_from_samples"], 8);
+    EXPECT_EQ(j["samples"], 12);
+}
+
+TEST(CpuReferenceCommand, LongReferenceAddsTheConvergenceCurve) {
+    TempDir tmp;
+    cli::ReferenceOptions o;
+    o.spp = 16;
+    o.maxBounces = 1;
+    o.resolution = "8x8";
+    o.noCache = true;
+    o.seed = 7;
+    o.outDir = (tmp.path() / "long").string();
+    o.quiet = true;
+    ASSERT_EQ(cli::runReference(o), cli::kExitOk);
+    o.spp = 8;
+    o.seed = 1;
+    o.outDir = (tmp.path() / "short").string();
+    o.longReference = (tmp.path() / "long" / "reference.exr").string();
+    ASSERT_EQ(cli::runReference(o), cli::kExitOk);
+    const nlohmann::json j = readJson(tmp.path() / "short" / "reference.json");
+    EXPECT_EQ(j["cache"]["enabled"], false);
+    ASSERT_EQ(j["convergence"]["curve"].size(), 2u);  // one point per batch of 4
+    EXPECT_EQ(j["convergence"]["curve"][1]["samples"], 8);
+    EXPECT_GT(j["convergence"]["curve"][1]["rel_mse_vs_long"].get<double>(), 0.0);
+    std::ifstream csv(tmp.path() / "short" / "convergence.csv");
+    std::string line;
+    int lines = 0;
+    while (std::getline(csv, line))
+        ++lines;
+    EXPECT_EQ(lines, 3);
+}
+
+TEST(CpuReferenceCommand, CancelWritesAPartialResultAndExits130) {
+    TempDir tmp;
+    std::atomic<bool> cancel{true};  // as if Ctrl-C came before the first batch finished
+    cli::ReferenceOptions o;
+    o.spp = 8;
+    o.maxBounces = 1;
+    o.resolution = "8x8";
+    o.cacheDir = (tmp.path() / "cache").string();
+    o.outDir = (tmp.path() / "out").string();
+    o.quiet = true;
+    o.cancel = &cancel;
+    EXPECT_EQ(cli::runReference(o), cli::kExitInterrupted);
+    const nlohmann::json j = readJson(tmp.path() / "out" / "reference.json");
+    EXPECT_EQ(j["status"], "partial");
+    EXPECT_EQ(j["stop_reason"], "cancelled");
+    EXPECT_EQ(cli::kExitInterrupted, 130);
+}
+
+// ---------------------------------------------------------------------------------------------
+// `gilab bench reference` (figures only; here: that every part runs and agrees with itself)
+
+TEST(CpuReferenceBench, ReplayAndConvergenceRunOnATinyScene) {
+    Scene scene = tinyScene();
+    scene.settings.width = scene.settings.height = 8;
+    ref::BenchOptions o;
+    o.spp = 8;
+    o.minReplaySeconds = 0.0;
+    o.longSpp = 64;
+    o.targetRelMse = 0.5;
+    const ref::BenchSceneResult r = ref::benchReferenceScene(scene, tinySettings(), o);
+    EXPECT_EQ(r.spp, 8u);
+    EXPECT_EQ(r.rays.cameraRays, 8u * 64u);
+    EXPECT_GT(r.replay.closestRays, 0u);
+    EXPECT_GT(r.replay.shadowRays, 0u);
+    ASSERT_FALSE(r.replay.closest.empty());
+    for (const auto* set : {&r.replay.closest, &r.replay.shadow})
+        for (const ref::ReplayRate& rate : *set)
+            EXPECT_GT(rate.raysPerSecond(), 0.0) << rate.method;
+    EXPECT_TRUE(r.replay.warnings.empty()) << r.replay.warnings.front();
+    EXPECT_GT(r.replay.closest.front().hitsPerPass, 0u);
+    EXPECT_LE(r.replay.closest.front().hitsPerPass, r.replay.closestRays);
+    EXPECT_GT(r.rawMixRaysPerSecond("1", r.threads), 0.0);
+    EXPECT_EQ(r.convergence.longSamples, 64u);
+    EXPECT_TRUE(r.convergence.reached);
+    EXPECT_LT(r.convergence.curve.back().relMseVsLong, 0.5);
+    EXPECT_TRUE(ref::benchSceneJson(r)["raw_embree"]["closest"].is_array());
+}
+
+}  // namespace gilab

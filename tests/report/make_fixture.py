@@ -1,0 +1,436 @@
+#!/usr/bin/python3
+"""Writes a synthetic, schema-faithful gilab results folder for the report's tests.
+
+    /usr/bin/python3 tests/report/make_fixture.py OUTDIR [--no-sweeps]
+
+Contents (schema 1, see scripts/report/report_data.py for what the report reads):
+  scenes      "cornell_box" (64x64; two metric regions; error bars from the reference's noise)
+              and "sponza#sun" (96x64; no regions, no error bars)
+  techniques  "direct" (0 bounces, nothing swept), "tech_a" (1-D sweep of cone_count),
+              "tech_b" (2-D grid voxel_res x steps)
+  failures    one unsupported run (tech_b, voxel_res=256 on sponza#sun), one nonfinite run
+              (tech_a, cone_count=16 on sponza#sun, magenta pixels), one folder with a malformed
+              result.json, one in-progress folder (.tmp-...) the report must ignore
+  metrics     final (vs. the bounce-matched reference), final_vs_full, indirect (techniques with
+              bounces), regions, energy_ratio; key names as experiments/metrics toJson writes them
+  images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), and final/indirect/flip
+              PNGs per run (EXR files are listed in "outputs" as the runner does but not written)
+With --no-sweeps: tech_a and tech_b have one run per scene and nothing is swept, and there are no
+regions, no error bars and no final_vs_full (for checking that those parts are left out).
+The numbers are made up but consistent: more cones / voxels / steps = lower error, more time.
+"""
+from __future__ import annotations
+
+import argparse
+import hashlib
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from typing import Optional
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+SCENES = {"cornell_box": (64, 64), "sponza#sun": (96, 64)}
+MATCHED = {0: "emission+direct", 1: "emission+direct+bounce1",
+           2: "emission+direct+bounce1+bounce2"}
+SKIPPED = {
+    "cornell_box": ["shared/shadow.2d: scene has no spot or directional lights",
+                    "shared/shadow.cube: scene has no point lights (or spots with an outer cone "
+                    "over 85 deg)"],
+    "sponza#sun": ["shared/shadow.cube: scene has no point lights (or spots with an outer cone "
+                   "over 85 deg)"],
+}
+REGIONS = ("ceiling", "indirect_dominant")
+
+
+@dataclass
+class Spec:
+    """One run to write."""
+
+    scene: str
+    technique: str
+    params: dict
+    swept: list[str]
+    status: str = "ok"
+    reason: str = ""
+    nan_pixels: int = 0
+    index: int = 0
+    notes: list[str] = field(default_factory=list)
+
+
+def run_specs(sweeps: bool) -> list[Spec]:
+    specs: list[Spec] = []
+    cones = [1, 2, 4, 8, 16] if sweeps else [4]
+    grid = [(v, s) for v in (32, 64, 128) for s in (8, 16)] if sweeps else [(64, 16)]
+    swept_a = ["cone_count"] if sweeps else []
+    swept_b = ["voxel_res", "steps"] if sweeps else []
+    for scene in SCENES:
+        specs.append(Spec(scene, "direct", {}, [],
+                          notes=["direct: baseline: indirect layer is zero by construction"]))
+        for n in cones:
+            bad = sweeps and scene == "sponza#sun" and n == 16
+            specs.append(Spec(scene, "tech_a", {"cone_count": n, "max_distance": 1.5}, swept_a,
+                              status="nonfinite" if bad else "ok", nan_pixels=37 if bad else 0))
+        for v, s in grid:
+            specs.append(Spec(scene, "tech_b", {"voxel_res": v, "steps": s, "temporal": False},
+                              swept_b))
+    specs.append(Spec("sponza#sun", "tech_b", {"voxel_res": 256, "steps": 16, "temporal": False},
+                      swept_b, status="unsupported",
+                      reason="tech_b: a 256^3 voxel grid needs 2.0 GiB, over the device's "
+                             "1.0 GiB allocation limit"))
+    for i, spec in enumerate(specs):
+        spec.index = i
+    return specs
+
+
+# ---------------------------------------------------------------------------------------------
+# Synthetic numbers
+# ---------------------------------------------------------------------------------------------
+
+def bounces(tech: str) -> int:
+    return {"direct": 0, "tech_a": 1, "tech_b": 1}[tech]
+
+
+def scene_factor(scene: str) -> float:
+    return 1.0 if scene == "cornell_box" else 1.2
+
+
+def flip_of(spec: Spec) -> float:
+    p = spec.params
+    if spec.technique == "direct":  # against the emission+direct reference: small error
+        base = 0.06
+    elif spec.technique == "tech_a":
+        base = 0.05 + 0.20 / math.sqrt(p["cone_count"])
+    else:
+        base = 0.04 + 6.0 / p["voxel_res"] + 0.4 / p["steps"]
+    return base * scene_factor(spec.scene)
+
+
+def flip_vs_full(spec: Spec) -> float:
+    """Against all the light: the baseline misses every bounce, the others the 2nd and later."""
+    missing = 0.30 if bounces(spec.technique) == 0 else 0.03
+    return flip_of(spec) + missing * scene_factor(spec.scene)
+
+
+def region_metrics(spec: Spec, flip: float, pixels: int, bars: bool) -> dict:
+    entry = {"pixels": pixels, "final": metric_set(flip, pixels, bars)}
+    if bounces(spec.technique):
+        entry["indirect"] = metric_set(min(1.0, flip * 1.8), pixels, bars)
+    return entry
+
+
+def pass_times(spec: Spec) -> list[tuple[str, float]]:
+    k = 1.0 if spec.scene == "cornell_box" else 1.5
+    passes = [("gbuffer", 0.4 * k), ("direct_light", 1.2 * k)]
+    p = spec.params
+    if spec.technique == "tech_a":
+        passes += [("tech_a/inject", 0.3 * k), ("tech_a/trace", 0.45 * p["cone_count"] * k)]
+    elif spec.technique == "tech_b":
+        r = p["voxel_res"] / 64.0
+        passes += [("tech_b/voxelize", 1.5 * r ** 3 * k),
+                   ("tech_b/march", 0.12 * p["steps"] * r * k)]
+    return passes
+
+
+def summary(median: float, rng: np.random.Generator, count: int = 5) -> dict:
+    samples = sorted(median * (1.0 + rng.normal(0.0, 0.04, count)))
+    samples[count // 2] = median
+    q1, q3 = float(np.percentile(samples, 25)), float(np.percentile(samples, 75))
+    return {"median": median, "q1": q1, "q3": q3, "iqr": q3 - q1, "min": min(samples),
+            "max": max(samples), "samples": [float(s) for s in rng.permutation(samples)]}
+
+
+def flip_stats(mean: float, pixels: int, exposures: bool) -> dict:
+    stats = {"mean": mean, "weighted_median": mean * 1.6, "weighted_p25": mean * 0.9,
+             "weighted_p75": mean * 2.2, "weighted_p95": min(1.0, mean * 3.5), "min": 0.0,
+             "max": min(1.0, mean * 6.0), "pixels": pixels}
+    if exposures:
+        stats.update({"start_exposure": -9.1, "stop_exposure": 2.3, "exposures": 12})
+    return stats
+
+
+def bar(spread: Optional[float], floor: float, value: float, lower_is_better: bool = True
+        ) -> dict:
+    if spread is None:  # not resampled (e.g. FLIP of final_vs_full)
+        return {"spread": None, "floor_mean": None, "floor_spread": None, "within_noise": False}
+    within = value <= floor + 2 * spread if lower_is_better else value >= floor - 2 * spread
+    return {"spread": spread, "floor_mean": floor, "floor_spread": spread * 0.5,
+            "within_noise": within}
+
+
+def error_bars(flip: float, mse: float, rel_mse: float, psnr_ldr: float, ssim: float,
+               within: bool, flip_resampled: bool) -> dict:
+    noise_floor = mse / 2.2 if within else mse / 40.0
+    flip_spread = 0.004 if flip_resampled else None
+    return {"resamples": 8, "mse_noise_floor": noise_floor, "mse_sigma": mse * 0.04,
+            "mse_debiased": mse - noise_floor, "rel_mse_noise_floor": rel_mse / 40.0,
+            "rel_mse_sigma": rel_mse * 0.05, "rel_mse_debiased": rel_mse * 0.97,
+            "psnr_ldr": bar(0.15, 44.0, psnr_ldr, lower_is_better=False),
+            "psnr_hdr": bar(0.2, 48.0, psnr_ldr + 4.0, lower_is_better=False),
+            "ssim": bar(0.002, 0.995, ssim, lower_is_better=False),
+            "flip": bar(flip_spread, 0.10, flip), "flip_ldr": bar(flip_spread, 0.09, flip * 0.9)}
+
+
+def metric_set(flip: float, pixels: int, bars: bool, nonfinite: int = 0,
+               flip_resampled: bool = True) -> dict:
+    """A metric set M as experiments/metrics toJson(MetricSet) writes it (docs/metrics.md)."""
+    rel_mse = 2.5 * flip * flip
+    psnr_ldr = 12.0 - 20.0 * math.log10(flip)
+    ssim = 1.0 - 0.9 * flip
+    mse = 0.8 * flip * flip
+    within = bars and flip < 0.115
+    included = pixels - nonfinite
+    return {"pixels": included, "region_pixels": pixels, "test_non_finite": nonfinite,
+            "ref_non_finite": 0, "has_non_finite": nonfinite > 0, "mse": mse,
+            "rmse": math.sqrt(mse), "rel_mse": rel_mse, "psnr_ldr": psnr_ldr,
+            "psnr_hdr": psnr_ldr + 4.0, "psnr_hdr_peak": 12.5, "ssim": ssim,
+            "flip": flip_stats(flip, included, True),
+            "flip_ldr": flip_stats(flip * 0.9, included, False),
+            "error_bars": error_bars(flip, mse, rel_mse, psnr_ldr, ssim, within, flip_resampled)
+            if bars else None,
+            "within_reference_noise": within}
+
+
+# ---------------------------------------------------------------------------------------------
+# Synthetic images
+# ---------------------------------------------------------------------------------------------
+
+def reference_layers(scene: str) -> tuple[np.ndarray, np.ndarray]:
+    """(direct + emission, one bounce of indirect) as display-ready RGB in [0, 1]."""
+    w, h = SCENES[scene]
+    y, x = np.mgrid[0:h, 0:w] / np.array([h - 1, w - 1])[:, None, None]
+    img = np.full((h, w, 3), 0.72)
+    if scene == "cornell_box":
+        img[x < 0.18] = (0.70, 0.12, 0.10)
+        img[x > 0.82] = (0.14, 0.55, 0.16)
+        img[(y > 0.3) & (y < 0.8) & (x > 0.3) & (x < 0.55)] = (0.55, 0.55, 0.52)
+        shade = 0.35 + 0.65 * (1.0 - y) ** 1.5
+        direct = img * shade[..., None]
+        direct[(y < 0.06) & (np.abs(x - 0.5) < 0.12)] = (1.0, 0.97, 0.9)
+        bleed = np.zeros_like(img)
+        bleed[..., 0] += 0.25 * np.exp(-x / 0.25)
+        bleed[..., 1] += 0.22 * np.exp(-(1.0 - x) / 0.25)
+        bleed += 0.12 * y[..., None]
+    else:
+        img[y < 0.25] = (0.55, 0.70, 0.95)
+        columns = (np.sin(x * 6 * np.pi) > 0.6) & (y > 0.25)
+        img[columns] = (0.60, 0.52, 0.40)
+        sun = (np.abs((x - y) - 0.1) < 0.18) & (y > 0.25)
+        direct = img * np.where(sun, 1.0, 0.25)[..., None]
+        bleed = np.zeros_like(img) + np.array([0.18, 0.14, 0.08]) * (y[..., None] > 0.25)
+    return np.clip(direct, 0, 1), np.clip(bleed, 0, 1)
+
+
+def reference_image(scene: str, bounce_count: int) -> np.ndarray:
+    direct, indirect = reference_layers(scene)
+    return np.clip(direct + indirect * min(bounce_count, 1) * (1.0 + 0.25 * (bounce_count - 1)),
+                   0, 1)
+
+
+def technique_images(spec: Spec, flip: float, rng: np.random.Generator
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(final, indirect, FLIP error map in [0, 1])."""
+    ref = reference_image(spec.scene, bounces(spec.technique))
+    direct, indirect = reference_layers(spec.scene)
+    if spec.technique == "direct":  # no indirect light; the shared direct pass is a bit dark
+        noisy = np.zeros_like(indirect)
+        direct = direct * 0.94
+    else:
+        noisy = indirect * (1.0 - flip) + rng.normal(0.0, flip * 0.12, indirect.shape)
+    if spec.technique == "tech_b":  # blocky, like a coarse voxel grid
+        block = max(1, 256 // spec.params["voxel_res"])
+        noisy = np.repeat(np.repeat(noisy[::block, ::block], block, 0), block, 1)
+        noisy = noisy[:ref.shape[0], :ref.shape[1]]
+    final = np.clip(direct + noisy, 0, 1)
+    error = np.clip(np.abs(final - ref).mean(axis=2) * 3.0, 0, 1)
+    if spec.nan_pixels:
+        idx = rng.choice(final.shape[0] * final.shape[1], spec.nan_pixels, replace=False)
+        final.reshape(-1, 3)[idx] = (1.0, 0.0, 1.0)
+    return final, np.clip(noisy, 0, 1), error
+
+
+def write_png(path: str, image: np.ndarray, cmap: Optional[str] = None) -> None:
+    os.makedirs(os.path.dirname(path), exist_ok=True)
+    if cmap:
+        plt.imsave(path, image, cmap=cmap, vmin=0.0, vmax=1.0)
+    else:
+        plt.imsave(path, image)
+
+
+# ---------------------------------------------------------------------------------------------
+# result.json
+# ---------------------------------------------------------------------------------------------
+
+def safe_label(label: str) -> str:
+    """The runner's folder name for a scene label (run_store.cpp sanitizeLabel)."""
+    return "".join(c if c.isalnum() or c in "-_" else "_" for c in label)
+
+
+def run_key(spec: Spec) -> str:
+    blob = json.dumps([spec.scene, spec.technique, spec.params], sort_keys=True)
+    return hashlib.sha1(blob.encode()).hexdigest()[:16]
+
+
+def base_result(spec: Spec, key: str) -> dict:
+    w, h = SCENES[spec.scene]
+    variant = spec.scene.partition("#")[2]
+    return {
+        "schema": 1, "status": spec.status, "key": key, "index": spec.index,
+        "experiment": "fixture",
+        "scene": {"label": spec.scene, "path": f"scenes/{spec.scene.partition('#')[0]}.json",
+                  "variant": variant, "resolution": [w, h]},
+        "technique": {"id": spec.technique, "description": f"synthetic {spec.technique}",
+                      "citation": "none (test fixture)",
+                      "indirect_bounces": bounces(spec.technique),
+                      "params": spec.params,
+                      "swept": {k: str(spec.params[k]) for k in spec.swept}},
+        "shared_params": {"shadows": True, "shadow_resolution": 1024, "area_light_samples": 16},
+        "provenance": {"gilab_version": "0.1.0",
+                       "git_commit": "a1b2c3d4e5f6" if spec.index < 12 else "0f9e8d7c6b5a",
+                       "build_type": "Release", "compiler": "GNU 12.2.0",
+                       "date": f"2026-11-{20 + spec.index // 12:02d}T10:{spec.index % 60:02d}:00Z",
+                       "host": "fixture-host", "cpu": "Synthetic CPU", "hardware_threads": 2,
+                       "command_line": "gilab run experiments/configs/fixture.json"},
+        "device": {"name": "Fixture GPU (synthetic)", "type": "discrete", "driver": "fixture",
+                   "driver_info": "synthetic 1.0", "vulkan_api": "1.3.280"},
+        "skipped_passes": SKIPPED[spec.scene] + (["tech_b/temporal: temporal=false"]
+                                                 if spec.technique == "tech_b" else []),
+        "notes": spec.notes,
+    }
+
+
+def timing_json(spec: Spec, rng: np.random.Generator) -> dict:
+    passes = pass_times(spec)
+    gpu = sum(v for _, v in passes)
+    tech_setup = {"direct": 0.004, "tech_a": 3.2,
+                  "tech_b": 0.05 * spec.params.get("voxel_res", 0)}[spec.technique]
+    setup = {"scene_upload": 0.55 if spec.scene == "cornell_box" else 14.0,
+             "shared_passes": 50.9, "shadow_maps": 108.6, "technique": tech_setup}
+    setup["total"] = sum(setup.values()) + 0.1
+    return {"policy": "docs/timing.md: warm-up discarded; median and IQR over timed frames",
+            "setup_ms": setup, "setup_gpu_passes": [{"name": "shadow_maps", "gpu_ms": 108.2}],
+            "warmup_frames": 2, "timed_frames": 5,
+            "frame_cpu_ms": summary(gpu + 0.3, rng), "frame_gpu_ms": summary(gpu, rng),
+            "passes": [{"name": n, "gpu_ms": summary(v, rng),
+                        "cpu_record_ms": summary(0.01, rng)} for n, v in passes]}
+
+
+def memory_json(spec: Spec) -> dict:
+    owners = {"scene": 3136 if spec.scene == "cornell_box" else 2_621_440, "shared": 27_333_120}
+    if spec.technique == "tech_a":
+        owners["tech_a"] = 1_048_576 * spec.params["cone_count"]
+    elif spec.technique == "tech_b":
+        owners["tech_b"] = 8 * spec.params["voxel_res"] ** 3
+    total = sum(owners.values())
+    return {"total_bytes": total, "peak_bytes": total + 262_144, "by_owner": owners,
+            "by_resource": {f"{k}/all": v for k, v in owners.items()}}
+
+
+def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> None:
+    key = run_key(spec)
+    folder = os.path.join(root, "runs", key)
+    os.makedirs(folder, exist_ok=True)
+    result = base_result(spec, key)
+    if spec.status == "unsupported":
+        result["reason"] = spec.reason
+    else:
+        matched = MATCHED[bounces(spec.technique)]
+        flip = flip_of(spec)
+        w, h = SCENES[spec.scene]
+        bars = sweeps and spec.scene == "cornell_box"
+        final, indirect, error = technique_images(spec, flip, rng)
+        write_png(os.path.join(folder, "final.png"), final)
+        write_png(os.path.join(folder, "indirect.png"), indirect)
+        write_png(os.path.join(folder, "flip.png"), error, cmap="magma")
+        metrics = {"final": metric_set(flip, w * h, bars, spec.nan_pixels)}
+        if sweeps:  # the runner writes it; the flat fixture checks the report without it
+            metrics["final_vs_full"] = metric_set(flip_vs_full(spec), w * h, bars,
+                                                  spec.nan_pixels, flip_resampled=False)
+        if bounces(spec.technique):
+            metrics["indirect"] = metric_set(min(1.0, flip * 1.8), w * h, bars, spec.nan_pixels)
+        if sweeps and spec.scene == "cornell_box":
+            metrics["regions"] = {name: region_metrics(spec, flip * f, w * h // 6, bars)
+                                  for name, f in zip(REGIONS, (0.8, 1.4))}
+        ratio = {"direct": 0.0, "tech_a": 1.0 - 0.8 * flip, "tech_b": 1.0 - 0.5 * flip}
+        metrics["energy_ratio"] = ratio[spec.technique]
+        label = safe_label(spec.scene)
+        result.update({
+            "reference": {"key": hashlib.sha1((label + matched).encode()).hexdigest()[:16],
+                          "samples": 256, "rel_error": 0.01, "matched": matched,
+                          "final_png": f"../../references/{label}/{matched}.png",
+                          "final_exr": f"../../references/{label}/{matched}.exr"},
+            "timing": timing_json(spec, rng), "memory": memory_json(spec), "metrics": metrics,
+            "nonfinite": {layer: {"nan_pixels": spec.nan_pixels if layer == "final" else 0,
+                                  "inf_pixels": 0, "negative_pixels": 0}
+                          for layer in ("final", "indirect", "direct")},
+            "validation": {"errors": 0, "warnings": 0},
+            "outputs": {"exr": "output.exr", "final_png": "final.png",
+                        "indirect_png": "indirect.png", "flip_png": "flip.png"}})
+    with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
+        json.dump(result, f, indent=2)
+
+
+def write_references(root: str) -> None:
+    for scene in SCENES:
+        for count, matched in MATCHED.items():
+            write_png(os.path.join(root, "references", safe_label(scene), f"{matched}.png"),
+                      reference_image(scene, count))
+
+
+def write_extras(root: str, specs: list[Spec]) -> None:
+    """experiment.json, a malformed run folder and an in-progress one."""
+    experiment = {"name": "fixture", "description": "Synthetic results for the report's tests: "
+                  "two scenes, a baseline and two fake techniques.",
+                  "config_path": "experiments/configs/fixture.json",
+                  "config_hash": "5eed5eed5eed5eed5eed5eed5eed5eed",
+                  "config": {"name": "fixture", "scenes": list(SCENES)},
+                  "runs_total": len(specs) + 1, "gilab_version": "0.1.0",
+                  "git_commit": "0f9e8d7c6b5a",
+                  "device": {"name": "Fixture GPU (synthetic)", "driver": "fixture"},
+                  "instrumentation": {"technique": "direct", "scene": "cornell_box",
+                                      "frames_each": 8, "frame_cpu_ms_with_timestamps": 1.93,
+                                      "frame_cpu_ms_without_timestamps": 1.88,
+                                      "overhead_ms": 0.05, "overhead_iqr_ms": 0.02}}
+    with open(os.path.join(root, "experiment.json"), "w", encoding="utf-8") as f:
+        json.dump(experiment, f, indent=2)
+    broken = os.path.join(root, "runs", "0badc0ffee0badc0")
+    os.makedirs(broken, exist_ok=True)
+    with open(os.path.join(broken, "result.json"), "w", encoding="utf-8") as f:
+        f.write('{"schema": 1, "status": "ok", "key": "0badc0ffee0badc0", "metrics": {')
+    partial = os.path.join(root, "runs", ".tmp-feedfacefeedface-4242")
+    os.makedirs(partial, exist_ok=True)
+    with open(os.path.join(partial, "result.json"), "w", encoding="utf-8") as f:
+        json.dump({"schema": 1, "status": "ok", "key": "feedfacefeedface"}, f)
+
+
+def write_fixture(root: str, sweeps: bool = True) -> list[Spec]:
+    """Writes the folder; returns the runs written (not counting the malformed/partial ones)."""
+    rng = np.random.default_rng(7)
+    specs = run_specs(sweeps)
+    os.makedirs(os.path.join(root, "runs"), exist_ok=True)
+    write_references(root)
+    for spec in specs:
+        write_run(root, spec, sweeps, rng)
+    write_extras(root, specs)
+    return specs
+
+
+def main(argv: list[str]) -> int:
+    parser = argparse.ArgumentParser(description="Writes a synthetic gilab results folder.")
+    parser.add_argument("out", metavar="OUTDIR")
+    parser.add_argument("--no-sweeps", action="store_true",
+                        help="no sweeps, no regions, no error bars")
+    args = parser.parse_args(argv)
+    specs = write_fixture(args.out, sweeps=not args.no_sweeps)
+    print(f"{args.out}: {len(specs)} runs")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

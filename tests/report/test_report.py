@@ -1,0 +1,386 @@
+#!/usr/bin/python3
+"""End-to-end test of scripts/report/make_report.py: synthetic results in, page checked in
+headless Chromium.
+
+    /usr/bin/python3 tests/report/test_report.py [--keep]
+
+Builds fixtures (tests/report/make_fixture.py) in a temporary folder, runs the report on them
+and checks the page: files it links exist, it loads with no console message and no uncaught
+exception (and that this detection works, on a deliberately broken page), the run table has one
+row per run and sorts, figures and sections are there when they apply and absent when they don't,
+shards merge, an empty folder and a missing one are handled. Chromium logs every console message
+at one level (INFO:CONSOLE), so any console line fails the test: the report logs nothing unless
+something is broken (e.g. an image that does not load). Prints "N passed, M failed" last; exits 0
+only if nothing failed, 77 (ctest SKIP_RETURN_CODE) if Chromium is not installed.
+"""
+from __future__ import annotations
+
+import html.parser
+import json
+import os
+import re
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.parse
+from dataclasses import dataclass, field
+from typing import Optional
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+REPORT = os.path.join(ROOT, "scripts", "report", "make_report.py")
+FIXTURE = os.path.join(HERE, "make_fixture.py")
+PYTHON = "/usr/bin/python3"
+CHROMIUM = "/usr/bin/chromium"
+SKIP = 77
+CONSOLE_LINE = re.compile(r"CONSOLE[:(]|Uncaught")
+SECTIONS = ("images", "runs", "pareto", "sweeps", "passes", "equal", "skipped", "unreadable")
+
+
+# ---------------------------------------------------------------------------------------------
+# Bookkeeping
+# ---------------------------------------------------------------------------------------------
+
+@dataclass
+class Checks:
+    passed: int = 0
+    failed: list[str] = field(default_factory=list)
+
+    def check(self, ok: bool, what: str, detail: str = "") -> bool:
+        if ok:
+            self.passed += 1
+            print(f"  ok    {what}")
+        else:
+            self.failed.append(what)
+            print(f"  FAIL  {what}" + (f"\n        {detail}" if detail else ""))
+        return ok
+
+
+def run(cmd: list[str], timeout: float = 60.0) -> subprocess.CompletedProcess:
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=timeout)
+
+
+# ---------------------------------------------------------------------------------------------
+# HTML and Chromium helpers
+# ---------------------------------------------------------------------------------------------
+
+class Elements(html.parser.HTMLParser):
+    """Every start tag with its attributes, in document order."""
+
+    def __init__(self) -> None:
+        super().__init__(convert_charrefs=True)
+        self.items: list[tuple[str, dict[str, str]]] = []
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, Optional[str]]]) -> None:
+        self.items.append((tag, {k: v or "" for k, v in attrs}))
+
+
+def elements(markup: str) -> list[tuple[str, dict[str, str]]]:
+    parser = Elements()
+    parser.feed(markup)
+    return parser.items
+
+
+def has_class(attrs: dict[str, str], name: str) -> bool:
+    return name in attrs.get("class", "").split()
+
+
+def missing_links(page_path: str) -> list[str]:
+    """Relative src/href values of the page that name no existing file."""
+    with open(page_path, encoding="utf-8") as f:
+        items = elements(f.read())
+    base = os.path.dirname(page_path)
+    missing = []
+    for _, attrs in items:
+        for name in ("src", "href"):
+            value = attrs.get(name)
+            if not value or value.startswith("#") or re.match(r"^[a-z][a-z0-9+.-]*:", value):
+                continue
+            path = urllib.parse.unquote(value.split("#")[0].split("?")[0])
+            if not os.path.exists(os.path.join(base, path)):
+                missing.append(value)
+    return missing
+
+
+def chromium(tmp: str, url: str, extra: list[str]) -> subprocess.CompletedProcess:
+    cmd = [CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
+           "--enable-logging=stderr", "--v=0", "--virtual-time-budget=3000",
+           f"--user-data-dir={os.path.join(tmp, 'chromium-profile')}"] + extra + [url]
+    return run(cmd, timeout=60.0)
+
+
+def console_problems(stderr: str) -> list[str]:
+    return [line for line in stderr.splitlines() if CONSOLE_LINE.search(line)]
+
+
+def load_dom(checks: Checks, tmp: str, page: str, what: str, fragment: str = "") -> str:
+    """Loads the page in Chromium, checks for console errors, returns the dumped DOM."""
+    url = "file://" + urllib.parse.quote(page) + fragment
+    result = chromium(tmp, url, ["--dump-dom"])
+    problems = console_problems(result.stderr)
+    checks.check(result.returncode == 0 and "<body" in result.stdout,
+                 f"{what}: Chromium dumps the DOM", result.stderr[-400:])
+    checks.check(not problems, f"{what}: no console errors or uncaught exceptions",
+                 "\n        ".join(problems[:5]))
+    return result.stdout
+
+
+def make_report(dirs: list[str], out: Optional[str] = None) -> subprocess.CompletedProcess:
+    return run([PYTHON, REPORT, *dirs] + (["--out", out] if out else []), timeout=120.0)
+
+
+def make_fixture(out: str, sweeps: bool = True) -> None:
+    result = run([PYTHON, FIXTURE, out] + ([] if sweeps else ["--no-sweeps"]))
+    if result.returncode != 0:
+        raise RuntimeError(f"make_fixture failed:\n{result.stderr}")
+
+
+def count_run_dirs(results_dir: str) -> int:
+    """Finished, readable runs the fixture wrote (folders with a parseable status)."""
+    runs = os.path.join(results_dir, "runs")
+    count = 0
+    for name in os.listdir(runs):
+        path = os.path.join(runs, name, "result.json")
+        if not name.startswith(".") and os.path.isfile(path):
+            with open(path, encoding="utf-8") as f:
+                count += '"status"' in f.read() and not name.startswith("0badc0ffee")
+    return count
+
+
+def run_rows(dom_items: list[tuple[str, dict[str, str]]]) -> int:
+    return sum(1 for tag, a in dom_items if tag == "tr" and has_class(a, "run-row"))
+
+
+def pareto_rows(results_dir: str) -> set[str]:
+    """Which error bases the error-vs-time figures show (from their panel titles)."""
+    rows = set()
+    for name in os.listdir(os.path.join(results_dir, "figures")):
+        if name.startswith("pareto_"):
+            with open(os.path.join(results_dir, "figures", name), encoding="utf-8") as f:
+                svg = f.read()
+            rows |= {"matched"} if "bounce-matched reference" in svg else set()
+            rows |= {"full"} if "full reference" in svg else set()
+    return rows
+
+
+def column_ids(dom_items: list[tuple[str, dict[str, str]]]) -> list[str]:
+    return [a["data-col"] for tag, a in dom_items if tag == "th" and "data-col" in a]
+
+
+# ---------------------------------------------------------------------------------------------
+# The checks
+# ---------------------------------------------------------------------------------------------
+
+def check_detection(checks: Checks, tmp: str) -> None:
+    """The console detection must fire on pages that are broken on purpose."""
+    cases = {"uncaught": "<script>undefinedFunction()</script>",
+             "console.error": "<script>console.error('broken on purpose')</script>"}
+    for name, script in cases.items():
+        page = os.path.join(tmp, f"broken-{name.replace('.', '-')}.html")
+        with open(page, "w", encoding="utf-8") as f:
+            f.write(f"<!DOCTYPE html><html><body><p>broken</p>{script}</body></html>")
+        result = chromium(tmp, "file://" + urllib.parse.quote(page), ["--dump-dom"])
+        checks.check(bool(console_problems(result.stderr)),
+                     f"negative check: a page with {name} is detected as broken")
+
+
+def check_main(checks: Checks, tmp: str) -> None:
+    fixture = os.path.join(tmp, "fixture")
+    make_fixture(fixture)
+    result = make_report([fixture])
+    page = os.path.join(fixture, "report.html")
+    checks.check(result.returncode == 0, "make_report exits 0", result.stderr[-600:])
+    checks.check(os.path.isfile(page), "report.html exists")
+    checks.check(result.stdout.strip().endswith(page), "make_report prints the path of the page")
+    missing = missing_links(page)
+    checks.check(not missing, "every relative src/href names an existing file", str(missing[:5]))
+
+    dom = load_dom(checks, tmp, page, "fixture page", "#sort=frame:asc")
+    items = elements(dom)
+    expected = count_run_dirs(fixture)
+    checks.check(run_rows(items) == expected, f"run table has {expected} rows",
+                 f"found {run_rows(items)}")
+    checks.check(any(tag == "body" and a.get("data-js") == "ready" for tag, a in items),
+                 "the page's script ran to the end")
+    frames = [a.get("data-v", "") for tag, a in items if tag == "td" and has_class(a, "c-frame")]
+    values = [float(v) for v in frames if v]
+    checks.check(len(values) > 1 and values == sorted(values)
+                 and frames[:len(values)] == [v for v in frames if v],
+                 "#sort=frame:asc sorts the run table by frame time (empty cells last)")
+    svgs = sorted(os.listdir(os.path.join(fixture, "figures")))
+    shown = {urllib.parse.unquote(a["src"]) for tag, a in items if tag == "img"
+             and a.get("src", "").startswith("figures/")}
+    checks.check(bool(svgs) and shown == {f"figures/{s}" for s in svgs},
+                 f"every figure ({len(svgs)} SVGs) is on the page as an <img>",
+                 f"svgs {svgs}, imgs {sorted(shown)}")
+    checks.check(any(s.startswith("sweep_tech_a_") for s in svgs)
+                 and any(s.startswith("sweep_tech_b_") for s in svgs),
+                 "sweep figures exist for tech_a and tech_b")
+    checks.check(not any(s.startswith("sweep_direct") for s in svgs),
+                 "no sweep figure for the technique without a sweep")
+    checks.check("256^3 voxel grid needs 2.0 GiB" in dom, "the unsupported run's reason is shown")
+    checks.check("0badc0ffee0badc0" in dom and "unreadable" in dom,
+                 "the malformed run folder is listed as unreadable with its path")
+    checks.check("feedfacefeedface" not in dom, "the in-progress (.tmp) run folder is ignored")
+    ids = {a.get("id") for _, a in items}
+    checks.check(all(s in ids for s in SECTIONS), "every section is present",
+                 str([s for s in SECTIONS if s not in ids]))
+    cols = column_ids(items)
+    checks.check({"region_ceiling", "region_indirect_dominant", "noise", "front", "flip_full",
+                  "flip_indirect"} <= set(cols),
+                 "region, within-noise, Pareto, vs-full and indirect columns are present",
+                 str(cols))
+    checks.check(pareto_rows(fixture) == {"matched", "full"},
+                 "error-vs-time figures have a matched and a full-reference row")
+    flip_cells = [a for tag, a in items if tag == "td" and has_class(a, "c-flip")]
+    checks.check(len(flip_cells) == expected and "±" in dom, "FLIP column with error bars")
+    images = [a for tag, a in items if tag == "img" and a.get("src", "").startswith("runs/")]
+    checks.check(len(images) >= 2 * (expected - 1), "final and FLIP images of every run",
+                 f"{len(images)} run images")
+    refs = {a["src"].split("/")[1] for tag, a in items
+            if tag == "img" and a.get("src", "").startswith("references/")}
+    checks.check(refs == {"cornell_box", "sponza_sun"}, "reference images of both scenes shown",
+                 str(refs))
+
+    shot = os.path.join(tmp, "report.png")
+    result = chromium(tmp, "file://" + urllib.parse.quote(page),
+                      [f"--screenshot={shot}", "--window-size=1400,3000", "--hide-scrollbars"])
+    size = os.path.getsize(shot) if os.path.isfile(shot) else 0
+    checks.check(size > 10_000, f"screenshot is a non-trivial PNG ({size} bytes)",
+                 result.stderr[-300:])
+
+
+def check_no_sweeps(checks: Checks, tmp: str) -> None:
+    fixture = os.path.join(tmp, "fixture-flat")
+    make_fixture(fixture, sweeps=False)
+    result = make_report([fixture])
+    page = os.path.join(fixture, "report.html")
+    checks.check(result.returncode == 0 and os.path.isfile(page), "no-sweep fixture: report built",
+                 result.stderr[-600:])
+    dom = load_dom(checks, tmp, page, "no-sweep page")
+    items = elements(dom)
+    ids = {a.get("id") for _, a in items}
+    svgs = os.listdir(os.path.join(fixture, "figures"))
+    checks.check("sweeps" not in ids and not any(s.startswith("sweep_") for s in svgs),
+                 "no-sweep fixture: no sweep section and no sweep figure")
+    cols = column_ids(items)
+    checks.check(not any(c.startswith("region_") for c in cols) and "noise" not in cols
+                 and "flip_full" not in cols,
+                 "no-sweep fixture: no region, within-noise or vs-full columns", str(cols))
+    checks.check(pareto_rows(fixture) == {"matched"},
+                 "no-sweep fixture: error-vs-time figures without a full-reference row")
+    flip_cells = re.findall(r'<td class="c-flip[^"]*"[^>]*>(.*?)</td>', dom)
+    checks.check(bool(flip_cells) and not any("±" in c for c in flip_cells),
+                 "no-sweep fixture: no error bars on FLIP")
+    checks.check(run_rows(items) == count_run_dirs(fixture), "no-sweep fixture: row count")
+
+
+def check_merge(checks: Checks, tmp: str) -> None:
+    source = os.path.join(tmp, "fixture")
+    shards = [os.path.join(tmp, "shard0"), os.path.join(tmp, "shard1")]
+    keys = sorted(k for k in os.listdir(os.path.join(source, "runs")) if not k.startswith("."))
+    readable = [k for k in keys if not k.startswith("0badc0ffee")]
+    placement = {0: keys[0::2], 1: keys[1::2] + [k for k in readable if k in keys[0::2]][:2]}
+    for i, shard in enumerate(shards):  # shard1 repeats 2 of shard0's readable runs
+        shutil.copytree(os.path.join(source, "references"), os.path.join(shard, "references"))
+        shutil.copy(os.path.join(source, "experiment.json"), shard)
+        for key in placement[i]:
+            shutil.copytree(os.path.join(source, "runs", key), os.path.join(shard, "runs", key))
+    out = os.path.join(tmp, "merged")
+    os.makedirs(os.path.join(out, "figures"))
+    with open(os.path.join(out, "figures", "stale.svg"), "w", encoding="utf-8") as f:
+        f.write("<svg/>")
+    result = make_report(shards, out)
+    page = os.path.join(out, "report.html")
+    checks.check(result.returncode == 0 and os.path.isfile(page), "merge: report built in --out",
+                 result.stderr[-600:])
+    with open(page, encoding="utf-8") as f:
+        markup = f.read()
+    checks.check(run_rows(elements(markup)) == count_run_dirs(source),
+                 "merge: runs in both shards are listed once")
+    checks.check("2 duplicates merged" in markup, "merge: the page says how many were merged")
+    checks.check(not missing_links(page), "merge: links into both shard folders resolve",
+                 str(missing_links(page)[:5]))
+    checks.check(not os.path.exists(os.path.join(out, "figures", "stale.svg")),
+                 "merge: figures of an earlier report are removed")
+
+
+HOSTILE_RUNS = {
+    "minimal": {"status": "ok"},
+    "wrong_types": {"status": "ok", "key": 5, "index": "x", "scene": 5, "technique": {
+        "id": None, "params": [1, 2], "swept": "cone_count"}, "metrics": None, "timing": "fast",
+        "memory": {"total_bytes": "many"}, "skipped_passes": "none", "notes": [None, 3],
+        "outputs": {"final_png": 7, "flip_png": "../../../nowhere.png"}, "provenance": []},
+    "nulls": {"status": "nonfinite", "scene": {"label": "s"}, "technique": {"id": "t",
+        "swept": {"k": "1"}}, "timing": {"frame_gpu_ms": {"median": None}, "passes": [
+        None, {"name": None, "gpu_ms": None}]}, "metrics": {"final": {"flip": {"mean": None},
+        "rel_mse": None, "error_bars": {"available": True, "flip": None}}, "regions": {
+        "r": None}}, "reference": {"final_png": None}},
+    "unknown_status": {"status": "running"},
+}
+
+
+def check_hostile(checks: Checks, tmp: str) -> None:
+    """Nulls, wrong types and odd statuses render as dashes or 'unreadable', never a crash."""
+    root = os.path.join(tmp, "hostile")
+    for name, data in HOSTILE_RUNS.items():
+        os.makedirs(os.path.join(root, "runs", name))
+        with open(os.path.join(root, "runs", name, "result.json"), "w", encoding="utf-8") as f:
+            json.dump(data, f)
+    os.makedirs(os.path.join(root, "runs", "a_list"))
+    with open(os.path.join(root, "runs", "a_list", "result.json"), "w", encoding="utf-8") as f:
+        f.write("[1, 2]")
+    os.makedirs(os.path.join(root, "runs", "no_result"))
+    result = make_report([root])
+    page = os.path.join(root, "report.html")
+    checks.check(result.returncode == 0 and os.path.isfile(page), "hostile values: report built",
+                 result.stderr[-800:])
+    if not os.path.isfile(page):
+        return
+    dom = load_dom(checks, tmp, page, "hostile page")
+    checks.check(run_rows(elements(dom)) == 3 and dom.count("st-unreadable") >= 4,
+                 "hostile values: 3 runs shown, 3 folders listed as unreadable")
+
+
+def check_edges(checks: Checks, tmp: str) -> None:
+    empty = os.path.join(tmp, "empty")
+    os.makedirs(os.path.join(empty, "runs"))
+    result = make_report([empty])
+    page = os.path.join(empty, "report.html")
+    checks.check(result.returncode == 0 and os.path.isfile(page), "empty folder: page written")
+    dom = load_dom(checks, tmp, page, "empty page")
+    checks.check('id="empty"' in dom and "No finished runs" in dom, "empty folder: page says so")
+    result = make_report([os.path.join(tmp, "does-not-exist")])
+    checks.check(result.returncode != 0 and "does not exist" in result.stderr,
+                 "missing folder: non-zero exit with a clear message", result.stderr)
+
+
+def main(argv: list[str]) -> int:
+    if not os.access(CHROMIUM, os.X_OK):
+        print(f"SKIP: {CHROMIUM} not found (apt-get install chromium)")
+        return SKIP
+    keep = "--keep" in argv
+    tmp = tempfile.mkdtemp(prefix="gilab-report-test-")
+    checks = Checks()
+    start = time.monotonic()
+    try:
+        for step in (check_detection, check_main, check_no_sweeps, check_merge, check_hostile,
+                     check_edges):
+            print(f"{step.__name__}:")
+            step(checks, tmp)
+    except Exception as e:  # a crash is a failure, with its message
+        checks.check(False, f"test ran without an exception: {type(e).__name__}: {e}")
+    finally:
+        if keep:
+            print(f"kept {tmp}")
+        else:
+            shutil.rmtree(tmp, ignore_errors=True)
+    print(f"({time.monotonic() - start:.1f} s)")
+    print(f"{checks.passed} passed, {len(checks.failed)} failed")
+    return 0 if not checks.failed else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
