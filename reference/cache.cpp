@@ -297,6 +297,7 @@ nlohmann::ordered_json settingsJson(const ReferenceSettings& settings) {
             {"roulette_start_bounce", settings.rouletteStartBounce},
             {"estimator", estimatorName(settings.estimator)},
             {"seed", settings.seed},
+            {"pixel_filter", pixelFilterName(settings.pixelFilter)},
             {"batch_samples", settings.batchSamples}};
 }
 

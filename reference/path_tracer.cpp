@@ -21,6 +21,13 @@
 namespace gilab::ref {
 namespace {
 
+/** The camera ray's position inside the pixel. The sampler's dimensions are consumed either
+ *  way, so both filters see the same random numbers along the rest of the path. */
+glm::vec2 pixelOffset(Sampler& sampler, PixelFilter filter) {
+    const glm::vec2 u = sampler.get2D();
+    return filter == PixelFilter::Center ? glm::vec2(0.5f) : u;
+}
+
 constexpr int kTileSize = 8;
 constexpr int kPacketSize = 4;  // camera rays of a 4 x 4 pixel block share one rtcIntersect16
 constexpr int kValuesPerPixel = kLayerCount * 3;
@@ -65,6 +72,10 @@ const char* layerName(Layer layer) {
             return "bounce3plus";
     }
     return "?";
+}
+
+const char* pixelFilterName(PixelFilter f) {
+    return f == PixelFilter::Center ? "center" : "box";
 }
 
 const char* estimatorName(Estimator e) {
@@ -151,7 +162,7 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
             const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
             for (uint64_t s = first; s < first + count; ++s) {
                 Sampler sampler(settings.seed, pixelIndex, s);
-                const glm::vec2 u = sampler.get2D();  // box filter over the pixel
+                const glm::vec2 u = pixelOffset(sampler, settings.pixelFilter);
                 const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
                 integrator.radiance(ray, nullptr, sampler, radiance, counters, sink);
                 add(p, radiance);
@@ -170,7 +181,7 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
                         for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x) {
                             const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
                             samplers[n] = Sampler(settings.seed, pixelIndex, s);
-                            const glm::vec2 u = samplers[n].get2D();
+                            const glm::vec2 u = pixelOffset(samplers[n], settings.pixelFilter);
                             const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
                             o[n] = ray.origin;
                             d[n] = ray.direction;
@@ -292,6 +303,7 @@ std::string PathTracer::toString() const {
         << "roulette_start_bounce: " << s.rouletteStartBounce
         << (s.rouletteStartBounce < 0 ? " (off)" : "") << "\n"
         << "seed: " << s.seed << "\n"
+        << "pixel filter: " << pixelFilterName(s.pixelFilter) << "\n"
         << "batch_samples: " << s.batchSamples << " (does not change the image)\n"
         << "pixel_filter: box over the pixel\n"
         << "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"

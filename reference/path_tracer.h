@@ -40,6 +40,14 @@ const char* layerName(Layer layer);
 enum class Estimator { Mis, NeeOnly, BsdfOnly };
 const char* estimatorName(Estimator e);  // "mis", "nee", "bsdf"
 
+/**
+ * Where a pixel's camera rays go. Box (default): uniformly over the pixel's square, the
+ * antialiased image. Center: every ray through the pixel centre, like the rasteriser's single
+ * sample per pixel, so comparisons with techniques carry no antialiasing differences at edges.
+ */
+enum class PixelFilter { Box, Center };
+const char* pixelFilterName(PixelFilter f);  // "box", "center"
+
 /** Bumped whenever a change alters the images; part of every reference cache key. */
 inline constexpr int kRendererVersion = 1;
 
@@ -51,13 +59,15 @@ struct ReferenceSettings {
     int rouletteStartBounce = -1;
     Estimator estimator = Estimator::Mis;
     uint64_t seed = 1;
+    PixelFilter pixelFilter = PixelFilter::Box;
     /** Samples added per pass over the image; the stop criteria are checked between passes. */
     uint32_t batchSamples = 4;
 };
 
 /**
  * Running sums per layer, pixel and channel (double), enough to continue a render and to
- * estimate the per-pixel variance of every layer. Index: ((layer * height + y) * width + x) * 3 + c.
+ * estimate the per-pixel variance of every layer. Index: ((layer * height + y) * width + x) * 3 +
+ * c.
  */
 struct Accumulator {
     int width = 0;
@@ -156,7 +166,7 @@ const char* stopReasonName(StopReason r);  // "samples", "rel_error", "time", "c
 struct ConvergencePoint {
     uint64_t samples;
     double seconds;
-    double relError;     // meanRelativeStdError(full)
+    double relError;      // meanRelativeStdError(full)
     double relMseVsLong;  // relative MSE of full vs a given longer reference, or NaN
 };
 

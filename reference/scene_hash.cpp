@@ -200,6 +200,7 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
     h.i32(settings.rouletteStartBounce);
     h.i32(int32_t(settings.estimator));
     h.u64(settings.seed);
+    h.i32(int32_t(settings.pixelFilter));
     h.tag("scene_data");
     h.str(dataHash);
 
@@ -224,7 +225,8 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
          {{"max_bounces", settings.maxBounces},
           {"roulette_start_bounce", settings.rouletteStartBounce},
           {"estimator", estimatorName(settings.estimator)},
-          {"seed", settings.seed}}},
+          {"seed", settings.seed},
+          {"pixel_filter", pixelFilterName(settings.pixelFilter)}}},
         {"scene_data_xxh3_128", dataHash},
         {"scene_data",
          {{"vertices", scene.vertices.size()},

@@ -1,8 +1,12 @@
 #!/usr/bin/env bash
-# README command 1: install, build, and run the main job on the built-in default scene.
+# README command 1: install, build, run the default experiment (the built-in Cornell box and its
+# spot-light variant: every technique against the path-traced reference) and write its report.
+# Re-running skips finished runs and reuses the cached references.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 "$root/scripts/install_deps.sh"
 "$root/scripts/build.sh"
 cd "$root"
-./build/gilab render --technique direct --out results/main
+./build/gilab run experiments/configs/default.json
+./build/gilab report results/default
+echo "gilab: open results/default/report.html"

@@ -134,6 +134,7 @@ TEST(CpuReferenceKey, EveryImageInputChangesTheKey) {
         {"roulette", [](Scene&, auto& r) { r.rouletteStartBounce = 3; }},
         {"estimator", [](Scene&, auto& r) { r.estimator = ref::Estimator::NeeOnly; }},
         {"seed", [](Scene&, auto& r) { r.seed += 1; }},
+        {"pixel filter", [](Scene&, auto& r) { r.pixelFilter = ref::PixelFilter::Center; }},
     };
     std::set<std::string> keys = {ref::referenceKey(tinyScene(), tinySettings())};
     for (const auto& [what, edit] : edits) {

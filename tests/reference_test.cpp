@@ -913,6 +913,34 @@ void measureThroughput(const Scene& scene, const ReferenceSettings& st, uint32_t
     setCameraPackets(true);
 }
 
+// Center: every camera ray goes through the pixel centre, so the emitter seen directly covers a
+// pixel fully or not at all; Box averages over the pixel and gives fractional edge pixels.
+TEST(CpuReferencePixelFilter, CenterSamplesPixelCentresBoxAveragesThePixel) {
+    Scene scene = makeBuiltinDefaultScene();
+    scene.settings.width = 24;
+    scene.settings.height = 24;
+    auto fractionalPixels = [&](PixelFilter filter) {
+        ReferenceSettings settings;
+        settings.maxBounces = 0;
+        settings.pixelFilter = filter;
+        PathTracer tracer(scene, settings);
+        Accumulator acc;
+        acc.reset(scene.settings.width, scene.settings.height);
+        tracer.addSamples(acc, 64);
+        int fractional = 0, lit = 0;
+        for (int y = 0; y < acc.height; ++y)
+            for (int x = 0; x < acc.width; ++x) {
+                const double v = acc.mean(Layer::Emission, x, y, 0);
+                if (v > 1e-6) ++lit;
+                if (v > 1e-6 && std::abs(v - 17.0) > 1e-4) ++fractional;
+            }
+        EXPECT_GT(lit, 0);
+        return fractional;
+    };
+    EXPECT_EQ(fractionalPixels(PixelFilter::Center), 0);
+    EXPECT_GT(fractionalPixels(PixelFilter::Box), 0);
+}
+
 TEST(CpuReferenceThroughput, DISABLED_CornellAndSponza) {
     Scene cornell = makeCornellBox(CornellBoxParams{});
     cornell.settings.width = cornell.settings.height = 256;

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/util/atomic_file.h"
 #include "core/util/error.h"
 
 namespace gilab::cli {
@@ -89,6 +90,11 @@ int runMain(int argc, char** argv) {
         ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
         ->capture_default_str();
     ref->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
+    ref->add_option("--pixel-filter", reference.pixelFilter,
+                    "box: rays over the whole pixel; center: through the pixel centre, like the "
+                    "rasteriser")
+        ->check(CLI::IsMember({"box", "center"}))
+        ->capture_default_str();
     ref->add_option("--batch", reference.batchSamples,
                     "Samples per pass (stop criteria are checked between passes; no effect on "
                     "the image)")
@@ -208,17 +214,7 @@ void applyResolutionOverride(Scene& scene, const std::string& text) {
 }
 
 void writeJsonAtomic(const std::string& path, const nlohmann::ordered_json& json) {
-    const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp);
-        out << json.dump(2) << "\n";
-        out.flush();
-        if (!out) throw Error("cannot write " + tmp);
-    }
-    if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-        std::remove(tmp.c_str());
-        throw Error("cannot rename " + tmp + " to " + path);
-    }
+    writeFileAtomic(path, json.dump(2) + "\n");
 }
 
 }  // namespace gilab::cli

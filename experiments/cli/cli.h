@@ -48,7 +48,8 @@ struct ReferenceOptions {
     double seconds = 0.0;
     int maxBounces = 32;
     int rouletteDepth = -1;
-    std::string estimator = "mis";  // mis | nee | bsdf
+    std::string estimator = "mis";    // mis | nee | bsdf
+    std::string pixelFilter = "box";  // "box" | "center"
     uint64_t seed = 1;
     uint32_t batchSamples = 4;
     std::string resolution;  // "WxH", "" = the scene's

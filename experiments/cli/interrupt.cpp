@@ -28,8 +28,12 @@ InterruptScope::InterruptScope(const char* message) {
     sigaction(SIGINT, &action, &m_previous);
 }
 
-InterruptScope::~InterruptScope() { sigaction(SIGINT, &m_previous, nullptr); }
+InterruptScope::~InterruptScope() {
+    sigaction(SIGINT, &m_previous, nullptr);
+}
 
-const std::atomic<bool>& InterruptScope::flag() const { return g_interrupted; }
+const std::atomic<bool>& InterruptScope::flag() const {
+    return g_interrupted;
+}
 
 }  // namespace gilab::cli

@@ -88,6 +88,8 @@ int runReference(const ReferenceOptions& options) {
     settings.maxBounces = options.maxBounces;
     settings.rouletteStartBounce = options.rouletteDepth;
     settings.estimator = parseEstimator(options.estimator);
+    settings.pixelFilter =
+        options.pixelFilter == "center" ? ref::PixelFilter::Center : ref::PixelFilter::Box;
     settings.seed = options.seed;
     settings.batchSamples = options.batchSamples;
     ref::StopCriteria stop{options.spp, options.relError, options.seconds};

@@ -1,5 +1,4 @@
 // `gilab render`: one technique, one scene -> <out>/<technique>.exr/.png/.json
-#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -18,20 +17,6 @@
 namespace gilab::cli {
 namespace {
 
-void applyResolution(Scene& scene, const std::string& text) {
-    if (text.empty()) return;
-    const size_t x = text.find('x');
-    int w = 0, h = 0;
-    const bool ok = x != std::string::npos &&
-                    std::from_chars(text.data(), text.data() + x, w).ptr == text.data() + x &&
-                    std::from_chars(text.data() + x + 1, text.data() + text.size(), h).ptr ==
-                        text.data() + text.size();
-    if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw Error("--resolution \"" + text + "\": expected WxH with 1 <= W, H <= 16384");
-    scene.settings.width = w;
-    scene.settings.height = h;
-}
-
 /** Splits --set assignments between the technique's and the shared passes' parameter sets. */
 void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
                       ParamSet& shared) {
@@ -44,22 +29,12 @@ void applyAssignments(const std::vector<std::string>& assignments, ParamSet& tec
     }
 }
 
-void writeJson(const std::filesystem::path& path, const nlohmann::ordered_json& json) {
-    const std::filesystem::path tmp = path.string() + ".tmp";
-    {
-        std::ofstream out(tmp);
-        out << json.dump(2) << "\n";
-        if (!out) throw Error("cannot write " + tmp.string());
-    }
-    std::filesystem::rename(tmp, path);
-}
-
 }  // namespace
 
 int runRender(const RenderOptions& options) {
     Progress::setQuiet(options.quiet);
     Scene scene = loadSceneOrDefault(options.scenePath);
-    applyResolution(scene, options.resolution);
+    applyResolutionOverride(scene, options.resolution);
     for (const std::string& w : scene.warnings)
         std::fprintf(stderr, "gilab: %s: warning: %s\n", scene.name.c_str(), w.c_str());
 
@@ -92,7 +67,7 @@ int runRender(const RenderOptions& options) {
     if (!harness.support().supported) {
         meta["status"] = "unsupported";
         meta["reason"] = harness.support().reason;
-        writeJson(base.string() + ".json", meta);
+        writeJsonAtomic(base.string() + ".json", meta);
         std::fprintf(stderr, "gilab: %s skipped on %s: %s\n", options.technique.c_str(),
                      scene.name.c_str(), harness.support().reason.c_str());
         return kExitUnsupported;
@@ -129,7 +104,7 @@ int runRender(const RenderOptions& options) {
     writePngTonemapped(base.string() + ".png", layers.front().image, tm);
     meta["outputs"] = {{"exr", base.string() + ".exr"}, {"png", base.string() + ".png"}};
     meta["status"] = nonFinite ? "nonfinite" : "ok";
-    writeJson(base.string() + ".json", meta);
+    writeJsonAtomic(base.string() + ".json", meta);
 
     const auto& cpu = meta["timing"]["frame_cpu_ms"];
     const auto& gpu = meta["timing"]["frame_gpu_ms"];

@@ -20,10 +20,11 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
         "(Ctrl-C again to abort)\n");
     const exp::RunnerSummary s = exp::runExperiment(options, &interrupt.flag());
     if (options.dryRun) return kExitOk;
-    std::printf("%s: %zu runs (%zu in this shard): %zu already finished, %zu ran (%zu unsupported, "
-                "%zu with non-finite pixels)%s\n",
-                s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.ran,
-                s.unsupported, s.nonfinite, s.cancelled ? ", interrupted" : "");
+    std::printf(
+        "%s: %zu runs (%zu in this shard): %zu already finished, %zu ran (%zu unsupported, "
+        "%zu with non-finite pixels)%s\n",
+        s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.ran, s.unsupported,
+        s.nonfinite, s.cancelled ? ", interrupted" : "");
     std::printf("report: gilab report %s\n", s.dir.string().c_str());
     if (s.cancelled || interrupt.interrupted()) return kExitInterrupted;
     return s.nonfinite ? kExitNonFinite : kExitOk;
@@ -46,7 +47,8 @@ int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
         args.push_back(outDir);
     }
     std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
+    for (std::string& a : args)
+        argv.push_back(a.data());
     argv.push_back(nullptr);
     std::fflush(stdout);
     const pid_t pid = ::fork();

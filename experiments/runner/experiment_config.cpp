@@ -16,7 +16,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defaultW, int defaultH) {
+SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defaultW,
+                      int defaultH) {
     SceneEntry entry;
     std::string spec;
     entry.width = defaultW;
@@ -57,7 +58,7 @@ SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defa
 ReferenceRequest parseReference(const JsonNode& node) {
     ReferenceRequest r;
     node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce", "seed",
-                     "estimator", "batch_spp"});
+                     "estimator", "batch_spp", "pixel_filter"});
     if (node.has("spp")) r.stop.maxSamples = uint64_t(node["spp"].integerIn(1, 1 << 24));
     if (node.has("rel_error")) r.stop.targetRelError = node["rel_error"].numberIn(0.0, 10.0);
     if (node.has("time_s")) r.stop.maxSeconds = node["time_s"].numberIn(0.0, 1e7);
@@ -67,13 +68,27 @@ ReferenceRequest parseReference(const JsonNode& node) {
     if (node.has("roulette_start_bounce"))
         r.settings.rouletteStartBounce = node["roulette_start_bounce"].integerIn(-1, 1024);
     if (node.has("seed")) r.settings.seed = uint64_t(node["seed"].integerIn(0, 1 << 30));
-    if (node.has("batch_spp")) r.settings.batchSamples = uint32_t(node["batch_spp"].integerIn(1, 4096));
+    if (node.has("batch_spp"))
+        r.settings.batchSamples = uint32_t(node["batch_spp"].integerIn(1, 4096));
+    if (node.has("pixel_filter")) {
+        const std::string f = node["pixel_filter"].string();
+        if (f == "box")
+            r.settings.pixelFilter = ref::PixelFilter::Box;
+        else if (f == "center")
+            r.settings.pixelFilter = ref::PixelFilter::Center;
+        else
+            node["pixel_filter"].fail("expected box or center (got \"" + f + "\")");
+    }
     if (node.has("estimator")) {
         const std::string e = node["estimator"].string();
-        if (e == "mis") r.settings.estimator = ref::Estimator::Mis;
-        else if (e == "nee") r.settings.estimator = ref::Estimator::NeeOnly;
-        else if (e == "bsdf") r.settings.estimator = ref::Estimator::BsdfOnly;
-        else node["estimator"].fail("expected mis, nee or bsdf (got \"" + e + "\")");
+        if (e == "mis")
+            r.settings.estimator = ref::Estimator::Mis;
+        else if (e == "nee")
+            r.settings.estimator = ref::Estimator::NeeOnly;
+        else if (e == "bsdf")
+            r.settings.estimator = ref::Estimator::BsdfOnly;
+        else
+            node["estimator"].fail("expected mis, nee or bsdf (got \"" + e + "\")");
     }
     return r;
 }
@@ -98,8 +113,10 @@ MetricOptionsSpec parseMetrics(const JsonNode& node) {
                 const JsonNode rect = r["rect"];
                 if (rect.arraySize() != 4) rect.fail("expected [x0, y0, x1, y1] in 0..1");
                 std::array<double, 4> v{};
-                for (size_t k = 0; k < 4; ++k) v[k] = rect.item(k).numberIn(0.0, 1.0);
-                if (v[2] <= v[0] || v[3] <= v[1]) rect.fail("empty rectangle (need x1 > x0, y1 > y0)");
+                for (size_t k = 0; k < 4; ++k)
+                    v[k] = rect.item(k).numberIn(0.0, 1.0);
+                if (v[2] <= v[0] || v[3] <= v[1])
+                    rect.fail("empty rectangle (need x1 > x0, y1 > y0)");
                 spec.rect = v;
             } else {
                 spec.indirectFractionAbove = r["indirect_fraction_above"].numberIn(0.0, 1.0);
@@ -159,7 +176,8 @@ std::vector<std::pair<std::string, std::vector<nlohmann::json>>> parseAxes(const
         } else if (value.is_object()) {
             values = expandRange(value, integer, axis.context() + ": \"" + axis.path() + "\"");
         } else {
-            axis.fail("expected a list of values or a range {\"linear\"|\"log\": [from, to, count]}");
+            axis.fail(
+                "expected a list of values or a range {\"linear\"|\"log\": [from, to, count]}");
         }
         if (values.empty()) axis.fail("no values to sweep");
         ParamSet probe = *target.params;
@@ -186,7 +204,8 @@ TechniqueEntry parseTechnique(const JsonNode& node) {
         node["technique"].fail(e.what());
     }
     if (node.has("params")) t.fixed = parseAssignments(node["params"], params);
-    for (const auto& [k, v] : t.fixed) params.setJson(k, v);
+    for (const auto& [k, v] : t.fixed)
+        params.setJson(k, v);
     if (node.has("shared")) t.shared = parseAssignments(node["shared"], defaultSharedParams());
     if (node.has("sweep")) {
         const JsonNode sweep = node["sweep"];
@@ -199,7 +218,8 @@ TechniqueEntry parseTechnique(const JsonNode& node) {
                 if (values.size() != t.zip.front().second.size())
                     sweep["zip"].fail("zipped lists must have equal lengths (\"" + key + "\" has " +
                                       std::to_string(values.size()) + ", \"" + t.zip.front().first +
-                                      "\" has " + std::to_string(t.zip.front().second.size()) + ")");
+                                      "\" has " + std::to_string(t.zip.front().second.size()) +
+                                      ")");
         }
         std::set<std::string> seen;
         for (const auto& axes : {t.grid, t.zip})
@@ -247,8 +267,10 @@ nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec) {
     nlohmann::ordered_json regions = nlohmann::ordered_json::array();
     for (const RegionSpec& r : spec.regions) {
         nlohmann::ordered_json j = {{"name", r.name}};
-        if (r.rect) j["rect"] = *r.rect;
-        else j["indirect_fraction_above"] = r.indirectFractionAbove;
+        if (r.rect)
+            j["rect"] = *r.rect;
+        else
+            j["indirect_fraction_above"] = r.indirectFractionAbove;
         regions.push_back(j);
     }
     return {{"ppd", spec.ppd}, {"exposure_ev", spec.exposureEv}, {"regions", regions}};
@@ -257,8 +279,8 @@ nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec) {
 ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::string& context,
                                        const std::string& baseDir) {
     const JsonNode root(json, context);
-    root.expectKeys({"name", "description", "scenes", "resolution", "reference", "timing", "metrics",
-                     "shared", "techniques"});
+    root.expectKeys({"name", "description", "scenes", "resolution", "reference", "timing",
+                     "metrics", "shared", "techniques"});
     ExperimentConfig c;
     c.path = context;
     c.name = root["name"].string();
@@ -317,10 +339,13 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
     for (const SceneEntry& scene : config.scenes) {
         for (const TechniqueEntry& t : config.techniques) {
             ParamSet base = TechniqueRegistry::instance().defaultParams(t.id);
-            for (const auto& [k, v] : t.fixed) base.setJson(k, v);
+            for (const auto& [k, v] : t.fixed)
+                base.setJson(k, v);
             ParamSet shared = defaultSharedParams();
-            for (const auto& [k, v] : config.shared) shared.setJson(k, v);
-            for (const auto& [k, v] : t.shared) shared.setJson(k, v);
+            for (const auto& [k, v] : config.shared)
+                shared.setJson(k, v);
+            for (const auto& [k, v] : t.shared)
+                shared.setJson(k, v);
             try {
                 (void)sharedSettingsFromParams(shared);
             } catch (const Error& e) {
@@ -344,7 +369,8 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
                 for (const auto& p : points)
                     for (size_t i = 0; i < t.zip.front().second.size(); ++i) {
                         auto q = p;
-                        for (const auto& [key, values] : t.zip) q[key] = values[i];
+                        for (const auto& [key, values] : t.zip)
+                            q[key] = values[i];
                         next.push_back(std::move(q));
                     }
                 points = std::move(next);

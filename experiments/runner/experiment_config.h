@@ -19,7 +19,8 @@
 namespace gilab::exp {
 
 struct SceneEntry {
-    std::string path;     // scene description, relative paths resolved against the config; "" = built-in
+    std::string
+        path;  // scene description, relative paths resolved against the config; "" = built-in
     std::string variant;  // "" = the file's base setup
     int width = 0;        // 0 = the scene's own resolution
     int height = 0;

@@ -12,7 +12,8 @@ void addInto(Image& sum, const Image& term) {
         sum = term;
         return;
     }
-    for (size_t i = 0; i < sum.values().size(); ++i) sum.values()[i] += term.values()[i];
+    for (size_t i = 0; i < sum.values().size(); ++i)
+        sum.values()[i] += term.values()[i];
 }
 
 void addSquaredInto(Image& sum, const Image& sigma) {
@@ -22,7 +23,8 @@ void addSquaredInto(Image& sum, const Image& sigma) {
 }
 
 void sqrtInPlace(Image& image) {
-    for (float& v : image.values()) v = std::sqrt(v);
+    for (float& v : image.values())
+        v = std::sqrt(v);
 }
 
 }  // namespace
@@ -32,7 +34,9 @@ ReferenceSet::ReferenceSet(ref::ReferenceResult result)
       m_mean(ref::meanLayers(m_result.acc)),
       m_stdError(ref::stdErrorLayers(m_result.acc)) {}
 
-const Image& ReferenceSet::mean(ref::Layer layer) const { return m_mean[size_t(layer)].image; }
+const Image& ReferenceSet::mean(ref::Layer layer) const {
+    return m_mean[size_t(layer)].image;
+}
 const Image& ReferenceSet::stdError(ref::Layer layer) const {
     return m_stdError[size_t(layer)].image;
 }
@@ -43,7 +47,8 @@ MatchedReference ReferenceSet::match(int bounces) const {
     m.full = mean(Layer::Full);
     m.fullStdError = stdError(Layer::Full);
     // All indirect light = bounce1 + bounce2 + bounce3plus.
-    for (Layer l : {Layer::Bounce1, Layer::Bounce2, Layer::Bounce3Plus}) addInto(m.fullIndirect, mean(l));
+    for (Layer l : {Layer::Bounce1, Layer::Bounce2, Layer::Bounce3Plus})
+        addInto(m.fullIndirect, mean(l));
 
     if (bounces == kAllBounces || bounces >= 3) {
         // bounce3plus holds every bounce >= 3, so n >= 3 can only be matched by the full image.

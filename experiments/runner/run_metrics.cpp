@@ -53,7 +53,8 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
         out["indirect"] =
             metrics::toJson(metrics::computeMetrics(indirect, reference.indirect, options));
     }
-    const Image& refIndirect = reference.indirect.empty() ? reference.fullIndirect : reference.indirect;
+    const Image& refIndirect =
+        reference.indirect.empty() ? reference.fullIndirect : reference.indirect;
     const double energy = metrics::computeEnergyRatio(indirect, refIndirect);
     out["energy_ratio"] = std::isfinite(energy) ? nlohmann::ordered_json(energy) : nullptr;
 

@@ -26,7 +26,8 @@ void syncFile(const fs::path& path) {
 std::string csvEscape(const std::string& s) {
     if (s.find_first_of(",\"\n") == std::string::npos) return s;
     std::string out = "\"";
-    for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+    for (char c : s)
+        out += c == '"' ? std::string("\"\"") : std::string(1, c);
     return out + "\"";
 }
 
@@ -60,7 +61,8 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
     std::string params;
     if (r.contains("technique") && r["technique"].contains("params"))
         for (const auto& [k, v] : r["technique"]["params"].items())
-            params += (params.empty() ? "" : " ") + k + "=" + (v.is_string() ? v.get<std::string>() : v.dump());
+            params += (params.empty() ? "" : " ") + k + "=" +
+                      (v.is_string() ? v.get<std::string>() : v.dump());
     return {{"key", at({"key"})},
             {"index", at({"index"})},
             {"experiment", at({"experiment"})},
@@ -95,18 +97,6 @@ bool isFinalStatus(const std::string& status) {
     return status == "ok" || status == "nonfinite" || status == "unsupported";
 }
 
-void writeFileAtomic(const fs::path& path, const std::string& contents) {
-    const fs::path tmp = path.string() + ".tmp-" + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        out << contents;
-        out.flush();
-        if (!out) throw Error("cannot write " + tmp.string());
-    }
-    syncFile(tmp);
-    fs::rename(tmp, path);
-}
-
 void flattenJson(const nlohmann::json& value, const std::string& prefix,
                  std::vector<std::pair<std::string, std::string>>& out) {
     if (value.is_object()) {
@@ -125,7 +115,9 @@ RunStore::RunStore(fs::path experimentDir) : m_dir(std::move(experimentDir)) {
     fs::create_directories(m_dir / "runs");
 }
 
-fs::path RunStore::runDir(const std::string& key) const { return m_dir / "runs" / key; }
+fs::path RunStore::runDir(const std::string& key) const {
+    return m_dir / "runs" / key;
+}
 
 bool RunStore::isFinished(const std::string& key) const {
     const fs::path result = runDir(key) / "result.json";
@@ -176,7 +168,8 @@ void RunStore::appendRow(const nlohmann::ordered_json& row) const {
         std::getline(in, line);
         std::stringstream ss(line);
         std::string cell;
-        while (std::getline(ss, cell, ',')) header.push_back(cell);
+        while (std::getline(ss, cell, ','))
+            header.push_back(cell);
     } else {
         std::string line;
         for (const auto& [k, v] : cells) {

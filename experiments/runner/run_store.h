@@ -17,6 +17,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/util/atomic_file.h"
+
 namespace gilab::exp {
 
 class RunStore {
@@ -58,8 +60,5 @@ std::string sanitizeLabel(const std::string& label);
  * "k=v ..."), status, set-up and frame times, memory, the headline metrics, provenance.
  */
 nlohmann::ordered_json resultRow(const nlohmann::ordered_json& result);
-
-/** Writes a file atomically: temporary name, flush, fsync, rename. */
-void writeFileAtomic(const std::filesystem::path& path, const std::string& contents);
 
 }  // namespace gilab::exp

@@ -38,9 +38,9 @@ public:
     const Scene& get(const SceneEntry& entry) {
         auto it = m_scenes.find(entry.label);
         if (it != m_scenes.end()) return *it->second;
-        auto scene = std::make_unique<Scene>(entry.path.empty()
-                                                 ? makeBuiltinDefaultScene()
-                                                 : loadSceneFile(entry.path, entry.variant));
+        auto scene =
+            std::make_unique<Scene>(entry.path.empty() ? makeBuiltinDefaultScene()
+                                                       : loadSceneFile(entry.path, entry.variant));
         if (entry.width > 0) {
             scene->settings.width = entry.width;
             scene->settings.height = entry.height;
@@ -91,7 +91,8 @@ const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scen
     std::fprintf(stderr, "[gilab] reference for %s\n", entry.label.c_str());
     ref::ReferenceResult r = ref::obtainReference(scene, c.config.reference.settings,
                                                   c.config.reference.stop, c.cache, opts);
-    for (const std::string& w : r.warnings) std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
+    for (const std::string& w : r.warnings)
+        std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
     if (!r.complete)
         throw Error("reference for " + entry.label + " was interrupted (" +
                     ref::stopReasonName(r.reason) + "); runs need a complete reference");
@@ -116,7 +117,9 @@ nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry
             {"final_exr", "../../references/" + safeLabel + "/" + m.name + ".exr"}};
 }
 
-std::string statusOf(size_t nonFinite) { return nonFinite ? "nonfinite" : "ok"; }
+std::string statusOf(size_t nonFinite) {
+    return nonFinite ? "nonfinite" : "ok";
+}
 
 /** Executes one run into a temporary folder and commits it. Returns its status. */
 std::string executeRun(Context& c, const RunSpec& run, const std::string& key, size_t position,
@@ -136,7 +139,8 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                        {"variant", run.scene->variant},
                        {"resolution", {scene.settings.width, scene.settings.height}}};
     nlohmann::ordered_json swept = nlohmann::ordered_json::object();
-    for (const auto& [k, v] : run.swept) swept[k] = v;
+    for (const auto& [k, v] : run.swept)
+        swept[k] = v;
     result["technique"] = {{"id", info.id},
                            {"description", info.description},
                            {"citation", info.citation},
@@ -253,9 +257,9 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
         keys.push_back(hashHex128(runIdentity(config, *r, probeScenes.get(*r->scene)).dump()));
     if (options.dryRun) {
         for (size_t i = 0; i < mine.size(); ++i)
-            std::printf("%4zu %s %-12s %-24s %s %s\n", mine[i]->index, keys[i].substr(0, 12).c_str(),
-                        mine[i]->techniqueId.c_str(), mine[i]->scene->label.c_str(),
-                        mine[i]->params.toString().c_str(),
+            std::printf("%4zu %s %-12s %-24s %s %s\n", mine[i]->index,
+                        keys[i].substr(0, 12).c_str(), mine[i]->techniqueId.c_str(),
+                        mine[i]->scene->label.c_str(), mine[i]->params.toString().c_str(),
                         store.isFinished(keys[i]) ? "[done]" : "[todo]");
         return summary;
     }

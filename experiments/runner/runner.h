@@ -27,8 +27,8 @@ struct RunnerOptions {
 
 struct RunnerSummary {
     std::filesystem::path dir;
-    size_t total = 0;           // runs in the config
-    size_t inShard = 0;         // runs of this shard
+    size_t total = 0;    // runs in the config
+    size_t inShard = 0;  // runs of this shard
     size_t alreadyFinished = 0;
     size_t ran = 0;
     size_t unsupported = 0;

@@ -9,11 +9,13 @@ namespace gilab::exp {
 nlohmann::ordered_json measureInstrumentationOverhead(vk::Context& vk, const Scene& scene,
                                                       int frames) {
     const char* kBaseline = "direct";
-    FrameHarness harness(vk, scene, kBaseline, TechniqueRegistry::instance().defaultParams(kBaseline),
+    FrameHarness harness(vk, scene, kBaseline,
+                         TechniqueRegistry::instance().defaultParams(kBaseline),
                          defaultSharedParams());
     if (!harness.support().supported) return {{"skipped", harness.support().reason}};
     harness.setup();
-    for (int i = 0; i < 2; ++i) harness.renderFrame();  // warm-up
+    for (int i = 0; i < 2; ++i)
+        harness.renderFrame();  // warm-up
     std::vector<double> with, without;
     for (int i = 0; i < frames; ++i) {
         harness.setTimestampsEnabled(true);
