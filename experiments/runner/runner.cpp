@@ -265,7 +265,8 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
     }
 
     size_t pending = 0;
-    for (const std::string& key : keys) pending += store.isFinished(key) ? 0 : 1;
+    for (const std::string& key : keys)
+        pending += store.isFinished(key) ? 0 : 1;
     if (pending == 0) {
         summary.alreadyFinished = mine.size();
         return summary;  // nothing to do: no device, no probe

@@ -1,0 +1,218 @@
+// Experiment configs (validation, sweep expansion, shards) and the runner end to end:
+// results are kept, re-runs skip finished runs, a deleted run is redone, shards are disjoint.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "core/util/error.h"
+#include "experiments/runner/experiment_config.h"
+#include "experiments/runner/run_store.h"
+#include "experiments/runner/runner.h"
+
+namespace gilab::exp {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path tempDir(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() /
+                         ("gilab_exp_" + name + "_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+nlohmann::json baseConfig() {
+    return nlohmann::json::parse(R"({
+        "name": "tiny",
+        "resolution": [16, 16],
+        "scenes": ["builtin"],
+        "reference": {"spp": 8, "max_bounces": 2, "pixel_filter": "center"},
+        "timing": {"warmup": 0, "frames": 1},
+        "techniques": [{"technique": "direct",
+                        "sweep": {"grid": {"shared.pcf_radius": [0, 1]}}}]
+    })");
+}
+
+/** Parses `json` and returns the error message ("" if it parsed). */
+std::string parseError(const nlohmann::json& json) {
+    try {
+        parseExperimentConfig(json, "cfg.json", ".");
+        return "";
+    } catch (const Error& e) {
+        return e.what();
+    }
+}
+
+TEST(CpuExperimentConfig, ExpandsGridTimesZipTimesScenes) {
+    nlohmann::json j = baseConfig();
+    j["scenes"] = {"builtin", std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot"};
+    j["techniques"][0]["sweep"] = {
+        {"grid", {{"shared.pcf_radius", {0, 1, 2}}}},
+        {"zip", {{"shared.area_light_samples", {4, 8}}, {"shared.shadow_resolution", {256, 512}}}}};
+    const ExperimentConfig c = parseExperimentConfig(j, "cfg.json", ".");
+    const std::vector<RunSpec> runs = expandRuns(c);
+    ASSERT_EQ(runs.size(), 2u * 3u * 2u);
+    EXPECT_EQ(runs[0].scene->label, "builtin");
+    EXPECT_EQ(runs[6].scene->label, "cornell_box#spot");
+    // Zipped keys move in lock step.
+    for (const RunSpec& r : runs)
+        EXPECT_EQ(r.shared.getInt("area_light_samples") == 4,
+                  r.shared.getInt("shadow_resolution") == 256);
+    EXPECT_EQ(runs[1].swept.at("shared.pcf_radius"), "0");
+    for (size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, i);
+}
+
+TEST(CpuExperimentConfig, RangesAreLinearOrLogAndIntegersRounded) {
+    const auto lin = expandRange({{"linear", {0.0, 1.0, 5}}}, false, "x");
+    ASSERT_EQ(lin.size(), 5u);
+    EXPECT_DOUBLE_EQ(lin[2].get<double>(), 0.5);
+    const auto lg = expandRange({{"log", {1, 1000, 4}}}, false, "x");
+    ASSERT_EQ(lg.size(), 4u);
+    EXPECT_NEAR(lg[1].get<double>(), 10.0, 1e-9);
+    const auto ints = expandRange({{"log", {1, 4, 5}}}, true, "x");  // 1 1.41 2 2.83 4
+    EXPECT_EQ(ints, (std::vector<nlohmann::json>{1, 2, 3, 4}));
+    EXPECT_THROW(expandRange({{"log", {0, 4, 5}}}, false, "x"), Error);
+    EXPECT_THROW(expandRange({{"cubic", {0, 4, 5}}}, false, "x"), Error);
+}
+
+TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
+    struct Case {
+        const char* what;
+        std::function<void(nlohmann::json&)> edit;
+        const char* expect;
+    };
+    const std::vector<Case> cases = {
+        {"unknown top-level key", [](auto& j) { j["refrence"] = 1; }, "refrence"},
+        {"unknown technique", [](auto& j) { j["techniques"][0]["technique"] = "vctt"; }, "vctt"},
+        {"unknown parameter",
+         [](auto& j) { j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radiu", {1}}}; },
+         "pcf_radiu"},
+        {"out of range",
+         [](auto& j) { j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radius", {1, 99}}}; },
+         "pcf_radius"},
+        {"zip lengths",
+         [](auto& j) {
+             j["techniques"][0]["sweep"] = {
+                 {"zip", {{"shared.pcf_radius", {0, 1}}, {"shared.shadow_resolution", {512}}}}};
+         },
+         "equal lengths"},
+        {"no stop criterion", [](auto& j) { j["reference"] = {{"max_bounces", 2}}; },
+         "stop criterion"},
+        {"missing scene file", [](auto& j) { j["scenes"] = {"no/such/scene.json"}; }, "not found"},
+        {"bad pixel filter", [](auto& j) { j["reference"]["pixel_filter"] = "gauss"; }, "gauss"},
+        {"fixed and swept",
+         [](auto& j) { j["techniques"][0]["shared"] = {{"pcf_radius", 1}}; }, "more than once"},
+        {"bad name", [](auto& j) { j["name"] = "a/b"; }, "name"},
+    };
+    for (const Case& c : cases) {
+        nlohmann::json j = baseConfig();
+        c.edit(j);
+        const std::string message = parseError(j);
+        EXPECT_NE(message.find("cfg.json"), std::string::npos) << c.what << ": " << message;
+        EXPECT_NE(message.find(c.expect), std::string::npos) << c.what << ": " << message;
+    }
+    EXPECT_EQ(parseError(baseConfig()), "");
+}
+
+TEST(CpuExperimentConfig, ShardsParse) {
+    EXPECT_EQ(parseShard("2/8"), std::make_pair(2, 8));
+    EXPECT_THROW(parseShard("8/8"), Error);
+    EXPECT_THROW(parseShard("x/2"), Error);
+}
+
+TEST(CpuRunStore, RowsAreAppendedAndFlattened) {
+    const fs::path dir = tempDir("store");
+    RunStore store(dir);
+    nlohmann::ordered_json result = {{"key", "k1"},
+                                     {"index", 0},
+                                     {"status", "ok"},
+                                     {"technique", {{"id", "direct"}, {"params", {{"a", 1}}}}},
+                                     {"metrics", {{"final", {{"flip", {{"mean", 0.25}}}}}}}};
+    store.appendRow(resultRow(result));
+    store.appendRow(resultRow(result));
+    std::ifstream jsonl(dir / "results.jsonl");
+    std::string line;
+    int rows = 0;
+    while (std::getline(jsonl, line)) {
+        const auto row = nlohmann::json::parse(line);
+        EXPECT_EQ(row["flip_mean"], 0.25);
+        EXPECT_EQ(row["params"], "a=1");
+        ++rows;
+    }
+    EXPECT_EQ(rows, 2);
+    std::ifstream csv(dir / "results.csv");
+    int csvLines = 0;
+    while (std::getline(csv, line)) ++csvLines;
+    EXPECT_EQ(csvLines, 3);  // header + 2 rows
+    fs::remove_all(dir);
+}
+
+class GpuRunner : public ::testing::Test {
+protected:
+    void SetUp() override {
+        m_dir = tempDir("runner");
+        m_config = (m_dir / "tiny.json").string();
+        std::ofstream(m_config) << baseConfig().dump(2);
+    }
+    void TearDown() override { fs::remove_all(m_dir); }
+    RunnerOptions options(int shard = 0, int count = 1) const {
+        RunnerOptions o;
+        o.configPath = m_config;
+        o.outRoot = (m_dir / "results").string();
+        o.referenceCacheDir = (m_dir / "cache").string();
+        o.quiet = true;
+        o.validation = true;
+        o.shardIndex = shard;
+        o.shardCount = count;
+        return o;
+    }
+    fs::path m_dir;
+    std::string m_config;
+};
+
+TEST_F(GpuRunner, KeepsResultsSkipsFinishedRunsAndRedoesMissingOnes) {
+    RunnerSummary s = runExperiment(options());
+    EXPECT_EQ(s.total, 2u);
+    EXPECT_EQ(s.ran, 2u);
+    RunStore store(s.dir);
+    const auto finished = store.loadFinished();
+    ASSERT_EQ(finished.size(), 2u);
+    for (const auto& r : finished) {
+        EXPECT_EQ(r["status"], "ok");
+        EXPECT_EQ(r["reference"]["matched"], "emission+direct");
+        EXPECT_TRUE(r["metrics"]["final"]["flip"]["mean"].is_number());
+        EXPECT_EQ(r["validation"]["errors"], 0);
+        const fs::path runDir = store.runDir(r["key"]);
+        for (const char* f : {"output.exr", "final.png", "flip.png", "result.json"})
+            EXPECT_TRUE(fs::exists(runDir / f)) << f;
+    }
+    EXPECT_TRUE(fs::exists(s.dir / "experiment.json"));
+
+    s = runExperiment(options());  // nothing left to do
+    EXPECT_EQ(s.ran, 0u);
+    EXPECT_EQ(s.alreadyFinished, 2u);
+
+    fs::remove_all(store.runDir(finished[0]["key"]));  // lose one run: only it is redone
+    s = runExperiment(options());
+    EXPECT_EQ(s.ran, 1u);
+    EXPECT_EQ(s.alreadyFinished, 1u);
+}
+
+TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
+    const RunnerSummary a = runExperiment(options(0, 2));
+    const RunnerSummary b = runExperiment(options(1, 2));
+    EXPECT_EQ(a.ran + b.ran, 2u);
+    EXPECT_EQ(a.inShard, 1u);
+    std::set<std::string> keys;
+    for (const auto& r : RunStore(a.dir).loadFinished()) keys.insert(r["key"]);
+    EXPECT_EQ(keys.size(), 2u);
+}
+
+}  // namespace
+}  // namespace gilab::exp
