@@ -20,8 +20,8 @@ namespace {
 namespace fs = std::filesystem;
 
 fs::path tempDir(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() /
-                         ("gilab_exp_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("gilab_exp_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     fs::create_directories(dir);
     return dir;
@@ -65,7 +65,8 @@ TEST(CpuExperimentConfig, ExpandsGridTimesZipTimesScenes) {
         EXPECT_EQ(r.shared.getInt("area_light_samples") == 4,
                   r.shared.getInt("shadow_resolution") == 256);
     EXPECT_EQ(runs[1].swept.at("shared.pcf_radius"), "0");
-    for (size_t i = 0; i < runs.size(); ++i) EXPECT_EQ(runs[i].index, i);
+    for (size_t i = 0; i < runs.size(); ++i)
+        EXPECT_EQ(runs[i].index, i);
 }
 
 TEST(CpuExperimentConfig, RangesAreLinearOrLogAndIntegersRounded) {
@@ -91,10 +92,14 @@ TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
         {"unknown top-level key", [](auto& j) { j["refrence"] = 1; }, "refrence"},
         {"unknown technique", [](auto& j) { j["techniques"][0]["technique"] = "vctt"; }, "vctt"},
         {"unknown parameter",
-         [](auto& j) { j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radiu", {1}}}; },
+         [](auto& j) {
+             j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radiu", {1}}};
+         },
          "pcf_radiu"},
         {"out of range",
-         [](auto& j) { j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radius", {1, 99}}}; },
+         [](auto& j) {
+             j["techniques"][0]["sweep"]["grid"] = {{"shared.pcf_radius", {1, 99}}};
+         },
          "pcf_radius"},
         {"zip lengths",
          [](auto& j) {
@@ -102,12 +107,18 @@ TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
                  {"zip", {{"shared.pcf_radius", {0, 1}}, {"shared.shadow_resolution", {512}}}}};
          },
          "equal lengths"},
-        {"no stop criterion", [](auto& j) { j["reference"] = {{"max_bounces", 2}}; },
+        {"no stop criterion",
+         [](auto& j) {
+             j["reference"] = {{"max_bounces", 2}};
+         },
          "stop criterion"},
         {"missing scene file", [](auto& j) { j["scenes"] = {"no/such/scene.json"}; }, "not found"},
         {"bad pixel filter", [](auto& j) { j["reference"]["pixel_filter"] = "gauss"; }, "gauss"},
         {"fixed and swept",
-         [](auto& j) { j["techniques"][0]["shared"] = {{"pcf_radius", 1}}; }, "more than once"},
+         [](auto& j) {
+             j["techniques"][0]["shared"] = {{"pcf_radius", 1}};
+         },
+         "more than once"},
         {"bad name", [](auto& j) { j["name"] = "a/b"; }, "name"},
     };
     for (const Case& c : cases) {
@@ -148,7 +159,8 @@ TEST(CpuRunStore, RowsAreAppendedAndFlattened) {
     EXPECT_EQ(rows, 2);
     std::ifstream csv(dir / "results.csv");
     int csvLines = 0;
-    while (std::getline(csv, line)) ++csvLines;
+    while (std::getline(csv, line))
+        ++csvLines;
     EXPECT_EQ(csvLines, 3);  // header + 2 rows
     fs::remove_all(dir);
 }
@@ -188,6 +200,8 @@ TEST_F(GpuRunner, KeepsResultsSkipsFinishedRunsAndRedoesMissingOnes) {
         EXPECT_EQ(r["reference"]["matched"], "emission+direct");
         EXPECT_TRUE(r["metrics"]["final"]["flip"]["mean"].is_number());
         EXPECT_EQ(r["validation"]["errors"], 0);
+        EXPECT_EQ(r["config_hash"].get<std::string>().size(), 32u);
+        EXPECT_FALSE(r["device"]["driver_info"].get<std::string>().empty());
         const fs::path runDir = store.runDir(r["key"]);
         for (const char* f : {"output.exr", "final.png", "flip.png", "result.json"})
             EXPECT_TRUE(fs::exists(runDir / f)) << f;
@@ -210,7 +224,8 @@ TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
     EXPECT_EQ(a.ran + b.ran, 2u);
     EXPECT_EQ(a.inShard, 1u);
     std::set<std::string> keys;
-    for (const auto& r : RunStore(a.dir).loadFinished()) keys.insert(r["key"]);
+    for (const auto& r : RunStore(a.dir).loadFinished())
+        keys.insert(r["key"]);
     EXPECT_EQ(keys.size(), 2u);
 }
 

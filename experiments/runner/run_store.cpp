@@ -89,6 +89,9 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
             {"nan_pixels_final", at({"nonfinite", "final", "nan_pixels"})},
             {"inf_pixels_final", at({"nonfinite", "final", "inf_pixels"})},
             {"device", at({"device", "name"})},
+            {"driver", at({"device", "driver_info"})},
+            {"vulkan_api", at({"device", "vulkan_api"})},
+            {"config_hash", at({"config_hash"})},
             {"git_commit", at({"provenance", "git_commit"})},
             {"date", at({"provenance", "date"})}};
 }
@@ -174,7 +177,8 @@ void RunStore::appendRow(const nlohmann::ordered_json& row) const {
         std::string line;
         for (const auto& [k, v] : cells) {
             header.push_back(k);
-            line += (line.empty() ? "" : ",") + csvEscape(k);
+            if (!line.empty()) line += ',';
+            line += csvEscape(k);
         }
         appendLine(csv, line);
     }
@@ -182,7 +186,8 @@ void RunStore::appendRow(const nlohmann::ordered_json& row) const {
     for (size_t i = 0; i < header.size(); ++i) {
         auto it = std::find_if(cells.begin(), cells.end(),
                                [&](const auto& c) { return c.first == header[i]; });
-        line += (i ? "," : "") + (it == cells.end() ? std::string() : csvEscape(it->second));
+        if (i) line += ',';
+        if (it != cells.end()) line += csvEscape(it->second);
     }
     appendLine(csv, line);
 }

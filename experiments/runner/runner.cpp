@@ -79,6 +79,7 @@ struct Context {
     std::map<std::string, std::unique_ptr<ReferenceSet>> references;
     std::map<std::string, bool> writtenReferencePreviews;
     const std::atomic<bool>* cancel;
+    std::string configHash;
 };
 
 const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene) {
@@ -149,6 +150,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                            {"swept", swept}};
     result["shared_params"] = run.shared.toOrderedJson();
     result["provenance"] = cli::provenanceJson(c.options.commandLine);
+    result["config_hash"] = c.configHash;
     result["device"] = cli::deviceJson(c.vk);
 
     FrameHarness harness(c.vk, scene, run.techniqueId, run.params, run.shared);
@@ -284,7 +286,8 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
         measureInstrumentationOverhead(vk, probeScenes.get(config.scenes.front()));
     writeFileAtomic(summary.dir / ("experiment.json"), experiment.dump(2));
 
-    Context c{config, options, store, vk, cache.get(), {}, {}, {}, cancel};
+    Context c{config, options, store, vk,     cache.get(),
+              {},     {},      {},    cancel, experiment["config_hash"].get<std::string>()};
     for (size_t i = 0; i < mine.size(); ++i) {
         if (cancel && cancel->load()) {
             summary.cancelled = true;
