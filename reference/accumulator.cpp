@@ -37,29 +37,39 @@ double Accumulator::stdError(Layer layer, int x, int y, int c) const {
     return std::sqrt(variance / n);
 }
 
+namespace {
+
+template <class PixelValue>
+Image layerImage(const Accumulator& acc, PixelValue value) {
+    Image image(acc.width, acc.height, 3);
+    for (int y = 0; y < acc.height; ++y)
+        for (int x = 0; x < acc.width; ++x)
+            for (int c = 0; c < 3; ++c)
+                image.at(x, y, c) = float(value(x, y, c));
+    return image;
+}
+
+}  // namespace
+
+Image meanImage(const Accumulator& acc, Layer layer) {
+    return layerImage(acc, [&](int x, int y, int c) { return acc.mean(layer, x, y, c); });
+}
+
+Image stdErrorImage(const Accumulator& acc, Layer layer) {
+    return layerImage(acc, [&](int x, int y, int c) { return acc.stdError(layer, x, y, c); });
+}
+
 std::vector<ImageLayer> meanLayers(const Accumulator& acc) {
     std::vector<ImageLayer> out;
-    for (int l = 0; l < kLayerCount; ++l) {
-        Image image(acc.width, acc.height, 3);
-        for (int y = 0; y < acc.height; ++y)
-            for (int x = 0; x < acc.width; ++x)
-                for (int c = 0; c < 3; ++c)
-                    image.at(x, y, c) = float(acc.mean(Layer(l), x, y, c));
-        out.push_back({layerName(Layer(l)), std::move(image)});
-    }
+    for (int l = 0; l < kLayerCount; ++l)
+        out.push_back({layerName(Layer(l)), meanImage(acc, Layer(l))});
     return out;
 }
 
 std::vector<ImageLayer> stdErrorLayers(const Accumulator& acc) {
     std::vector<ImageLayer> out;
-    for (int l = 0; l < kLayerCount; ++l) {
-        Image image(acc.width, acc.height, 3);
-        for (int y = 0; y < acc.height; ++y)
-            for (int x = 0; x < acc.width; ++x)
-                for (int c = 0; c < 3; ++c)
-                    image.at(x, y, c) = float(acc.stdError(Layer(l), x, y, c));
-        out.push_back({std::string(layerName(Layer(l))) + "_stderr", std::move(image)});
-    }
+    for (int l = 0; l < kLayerCount; ++l)
+        out.push_back({std::string(layerName(Layer(l))) + "_stderr", stdErrorImage(acc, Layer(l))});
     return out;
 }
 

@@ -12,16 +12,6 @@
 namespace gilab::ref {
 namespace {
 
-/** The mean of the full layer as an RGB image. */
-Image fullMean(const Accumulator& acc) {
-    Image image(acc.width, acc.height, 3);
-    for (int y = 0; y < acc.height; ++y)
-        for (int x = 0; x < acc.width; ++x)
-            for (int c = 0; c < 3; ++c)
-                image.at(x, y, c) = float(acc.mean(Layer::Full, x, y, c));
-    return image;
-}
-
 /**
  * Expected relative MSE of a 1-sample image, from the per-pixel sample variance of `acc`:
  * E[(mean_n - mu)^2] = var / n, divided as relativeMse() divides (by mu^2 + 1e-2).
@@ -68,7 +58,7 @@ BenchConvergence measureConvergence(const Scene& scene, const ReferenceSettings&
             renderUntil(longTracer, longAcc, StopCriteria{conv.longSamples, 0.0, o.maxLongSeconds});
         conv.longSamples = longAcc.samples;
         conv.longSeconds = report.seconds;
-        longImage = fullMean(longAcc);
+        longImage = meanImage(longAcc, Layer::Full);
     }
 
     // 2. A fresh run, checked against it after every batch until it first drops below target
@@ -81,7 +71,7 @@ BenchConvergence measureConvergence(const Scene& scene, const ReferenceSettings&
         Stopwatch watch;
         tracer.addSamples(fresh, uint32_t(batch));
         seconds += watch.elapsedMs() * 1e-3;
-        const double mse = relativeMse(fullMean(fresh), longImage);
+        const double mse = relativeMse(meanImage(fresh, Layer::Full), longImage);
         conv.curve.push_back({fresh.samples, seconds, meanRelativeStdError(fresh), mse});
         char detail[96];
         std::snprintf(detail, sizeof detail, "%llu spp, rel MSE %.3g",

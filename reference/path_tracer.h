@@ -89,6 +89,9 @@ struct Accumulator {
     double stdError(Layer layer, int x, int y, int c) const;
 };
 
+/** The mean (or standard-error) image of one layer, RGB. */
+Image meanImage(const Accumulator& acc, Layer layer);
+Image stdErrorImage(const Accumulator& acc, Layer layer);
 /** Mean images, named by layerName(), in Layer order. */
 std::vector<ImageLayer> meanLayers(const Accumulator& acc);
 /** Standard-error images, named "<layer>_stderr", in Layer order. */

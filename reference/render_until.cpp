@@ -12,15 +12,6 @@
 namespace gilab::ref {
 namespace {
 
-Image meanFullImage(const Accumulator& acc) {
-    Image image(acc.width, acc.height, 3);
-    for (int y = 0; y < acc.height; ++y)
-        for (int x = 0; x < acc.width; ++x)
-            for (int c = 0; c < 3; ++c)
-                image.at(x, y, c) = float(acc.mean(Layer::Full, x, y, c));
-    return image;
-}
-
 RayStats difference(const RayStats& after, const RayStats& before) {
     RayStats d;
     d.cameraRays = after.cameraRays - before.cameraRays;
@@ -93,8 +84,9 @@ RenderReport renderUntil(PathTracer& tracer, Accumulator& acc, const StopCriteri
         }
         const double seconds = watch.elapsedMs() * 1e-3;
         report.relError = meanRelativeStdError(acc, Layer::Full);
-        const double relMse = longReference ? relativeMse(meanFullImage(acc), *longReference)
-                                            : std::numeric_limits<double>::quiet_NaN();
+        const double relMse = longReference
+                                  ? relativeMse(meanImage(acc, Layer::Full), *longReference)
+                                  : std::numeric_limits<double>::quiet_NaN();
         report.curve.push_back({acc.samples, seconds, report.relError, relMse});
 
         // Progress: rate of this call and the nearest criterion's ETA (error ~ 1/sqrt(n))

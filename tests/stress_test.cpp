@@ -39,7 +39,9 @@ void expectFiniteNonNegative(const Image& image, const std::string& what) {
     EXPECT_EQ(s.negativePixels, 0u) << what;
 }
 
-TEST(CpuStress, SceneSetIsPresent) { EXPECT_GE(stressScenes().size(), 6u); }
+TEST(CpuStress, SceneSetIsPresent) {
+    EXPECT_GE(stressScenes().size(), 6u);
+}
 
 TEST(GpuStress, EveryTechniqueIsFiniteOrSkipsWithAReason) {
     vk::ContextOptions options;
@@ -49,7 +51,8 @@ TEST(GpuStress, EveryTechniqueIsFiniteOrSkipsWithAReason) {
         const Scene scene = loadSmall(path);
         for (const TechniqueInfo* info : TechniqueRegistry::instance().list()) {
             const std::string what = info->id + " on " + scene.name;
-            FrameHarness h(ctx, scene, info->id, TechniqueRegistry::instance().defaultParams(info->id),
+            FrameHarness h(ctx, scene, info->id,
+                           TechniqueRegistry::instance().defaultParams(info->id),
                            defaultSharedParams());
             if (!h.support().supported) {
                 EXPECT_FALSE(h.support().reason.empty()) << what;
@@ -61,7 +64,8 @@ TEST(GpuStress, EveryTechniqueIsFiniteOrSkipsWithAReason) {
                 if (l.name != "normal") expectFiniteNonNegative(l.image, what + " / " + l.name);
         }
     }
-    for (const std::string& m : ctx.validationMessages()) ADD_FAILURE() << m;
+    for (const std::string& m : ctx.validationMessages())
+        ADD_FAILURE() << m;
     EXPECT_EQ(ctx.validationErrorCount(), 0u);
 }
 
@@ -92,7 +96,8 @@ TEST(CpuStress, ClosedThinWalledBoxIsDarkInTheReference) {
     acc.reset(scene.settings.width, scene.settings.height);
     tracer.addSamples(acc, 16);
     for (const ImageLayer& l : ref::meanLayers(acc))
-        for (float v : l.image.values()) ASSERT_EQ(v, 0.0f) << l.name;
+        for (float v : l.image.values())
+            ASSERT_EQ(v, 0.0f) << l.name;
 }
 
 }  // namespace
