@@ -9,7 +9,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <glm/glm.hpp>
+#include "tests/gpu_test_fixture.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/emitter_samples.h"
@@ -93,26 +95,8 @@ struct Frame {
     }
 };
 
-class GpuPassesTest : public ::testing::Test {
+class GpuPassesTest : public test::ValidatedGpuTest {
 protected:
-    void SetUp() override {
-        vk::ContextOptions options;
-        options.validation = true;
-        m_ctx = std::make_unique<vk::Context>(options);
-    }
-    void TearDown() override {
-        const uint32_t errors = m_ctx->validationErrorCount();
-        const uint32_t warnings = m_ctx->validationWarningCount();
-        EXPECT_EQ(errors, 0u);
-        EXPECT_EQ(warnings, 0u);
-        if (errors + warnings > 0) {
-            for (const std::string& m : m_ctx->validationMessages()) {
-                std::printf("%s\n", m.c_str());
-            }
-        }
-        m_ctx.reset();
-    }
-
     Frame render(Scene scene, const Camera& camera, const SharedPassSettings& settings = {},
                  uint32_t width = kSize, uint32_t height = kSize) {
         scene.computeCaps();
@@ -134,8 +118,6 @@ protected:
         f.gpuLights = gpuScene.gpuLights();
         return f;
     }
-
-    std::unique_ptr<vk::Context> m_ctx;
 };
 
 /** Measured irradiance E = Lo * pi / albedo of a Lambertian pixel (per channel). */

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/gpu_test_fixture.h"
+
 #include "core/image/color.h"
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
@@ -22,21 +24,7 @@
 namespace gilab {
 namespace {
 
-class GpuReferenceVsDirect : public ::testing::Test {
-protected:
-    void SetUp() override {
-        vk::ContextOptions options;
-        options.validation = true;
-        ctx = std::make_unique<vk::Context>(options);
-    }
-    void TearDown() override {
-        for (const std::string& m : ctx->validationMessages())
-            ADD_FAILURE() << m;
-        EXPECT_EQ(ctx->validationErrorCount(), 0u);
-        EXPECT_EQ(ctx->validationWarningCount(), 0u);
-    }
-    std::unique_ptr<vk::Context> ctx;
-};
+using GpuReferenceVsDirect = test::ValidatedGpuTest;
 
 const Image& layer(const std::vector<ImageLayer>& layers, const std::string& name) {
     for (const ImageLayer& l : layers)
@@ -203,9 +191,9 @@ TEST_F(GpuReferenceVsDirect, CornellSpotDirectAgrees) {
     constexpr int kSize = 64, kFactor = 4;
     constexpr uint32_t kSpp = 4096;
     const Scene scene = cornell("spot", kSize);
-    const auto gpu = renderDirect(*ctx, scene, true, kFactor);
-    const auto gpuUnshadowed = renderDirect(*ctx, scene, false, kFactor);
-    const auto gpuCentres = renderDirect(*ctx, scene, true, 1);
+    const auto gpu = renderDirect(*m_ctx, scene, true, kFactor);
+    const auto gpuUnshadowed = renderDirect(*m_ctx, scene, false, kFactor);
+    const auto gpuCentres = renderDirect(*m_ctx, scene, true, 1);
     const ref::Accumulator acc = renderReference(scene, kSpp);
     const Image refDirect = ref::meanLayers(acc)[int(ref::Layer::Direct)].image;
     const Image refStdErr = ref::stdErrorLayers(acc)[int(ref::Layer::Direct)].image;
@@ -251,7 +239,7 @@ TEST_F(GpuReferenceVsDirect, CornellAreaLightEmissionAgrees) {
     // 128 x 128: the ceiling light, seen at a grazing angle, is ~4 pixels tall
     constexpr int kSize = 128;
     const Scene scene = cornell("", kSize);
-    const auto gpu = renderDirect(*ctx, scene, true, 1);
+    const auto gpu = renderDirect(*m_ctx, scene, true, 1);
     const ref::Accumulator acc = renderReference(scene, 64);
     const std::vector<ImageLayer> refLayers = ref::meanLayers(acc);
     const Image& refE = refLayers[int(ref::Layer::Emission)].image;

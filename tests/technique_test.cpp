@@ -5,7 +5,9 @@
 #include <fstream>
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
+#include "tests/gpu_test_fixture.h"
 
 #include "core/image/image_io.h"
 #include "core/scene/scene_loader.h"
@@ -55,21 +57,7 @@ Scene smallBox(const std::string& variant = "") {
     return scene;
 }
 
-class GpuHarness : public ::testing::Test {
-protected:
-    void SetUp() override {
-        vk::ContextOptions options;
-        options.validation = true;
-        ctx = std::make_unique<vk::Context>(options);
-    }
-    void TearDown() override {
-        for (const std::string& m : ctx->validationMessages())
-            ADD_FAILURE() << m;
-        EXPECT_EQ(ctx->validationErrorCount(), 0u);
-        EXPECT_EQ(ctx->validationWarningCount(), 0u);
-    }
-    std::unique_ptr<vk::Context> ctx;
-};
+using GpuHarness = test::ValidatedGpuTest;
 
 const ImageLayer& layer(const std::vector<ImageLayer>& layers, const std::string& name) {
     for (const ImageLayer& l : layers)
@@ -121,7 +109,7 @@ TEST(CpuRegistry, UnsupportedSceneGivesReason) {
 
 TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
     const Scene scene = smallBox();
-    FrameHarness h(*ctx, scene, "direct", TechniqueRegistry::instance().defaultParams("direct"),
+    FrameHarness h(*m_ctx, scene, "direct", TechniqueRegistry::instance().defaultParams("direct"),
                    defaultSharedParams());
     ASSERT_TRUE(h.support().supported) << h.support().reason;
     const SetupTiming setup = h.setup();
@@ -179,7 +167,7 @@ TEST_F(GpuHarness, DirectOnCornellBoxHasFiniteLayersAndNamedPasses) {
 TEST_F(GpuHarness, DummyIndirectIsComposedAndRebuildsOnlyOnRebuildKeys) {
     const Scene scene = smallBox();  // area light only: the dummy supports it
     ParamSet params = TechniqueRegistry::instance().defaultParams("dummy_constant");
-    FrameHarness h(*ctx, scene, "dummy_constant", params, defaultSharedParams());
+    FrameHarness h(*m_ctx, scene, "dummy_constant", params, defaultSharedParams());
     ASSERT_TRUE(h.support().supported) << h.support().reason;
     DummyConstantTechnique::setupCount = 0;
     h.setup();
@@ -207,7 +195,7 @@ TEST_F(GpuHarness, DummyIndirectIsComposedAndRebuildsOnlyOnRebuildKeys) {
 
 TEST_F(GpuHarness, UnsupportedSceneThrowsOnSetup) {
     const Scene scene = smallBox("spot");
-    FrameHarness h(*ctx, scene, "dummy_constant",
+    FrameHarness h(*m_ctx, scene, "dummy_constant",
                    TechniqueRegistry::instance().defaultParams("dummy_constant"),
                    defaultSharedParams());
     EXPECT_FALSE(h.support().supported);

@@ -11,7 +11,9 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+
 #include <glm/glm.hpp>
+#include "tests/gpu_test_fixture.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/scene/mesh_builder.h"
@@ -124,25 +126,8 @@ std::pair<size_t, size_t> compareOccupancy(const std::set<Cell>& gpu, const std:
     return {misses, extras};
 }
 
-class GpuVoxelTest : public ::testing::Test {
+class GpuVoxelTest : public test::ValidatedGpuTest {
 protected:
-    void SetUp() override {
-        vk::ContextOptions options;
-        options.validation = true;
-        m_ctx = std::make_unique<vk::Context>(options);
-    }
-    void TearDown() override {
-        const uint32_t errors = m_ctx->validationErrorCount();
-        const uint32_t warnings = m_ctx->validationWarningCount();
-        EXPECT_EQ(errors, 0u);
-        EXPECT_EQ(warnings, 0u);
-        if (errors + warnings > 0) {
-            for (const std::string& m : m_ctx->validationMessages())
-                std::printf("%s\n", m.c_str());
-        }
-        m_ctx.reset();
-    }
-
     VoxelData voxelize(Scene scene, const VoxelGrid& grid, const VoxelizerOptions& options = {}) {
         scene.computeCaps();
         vk::GpuScene gpuScene(*m_ctx, scene);
@@ -150,8 +135,6 @@ protected:
         voxelizer.run();
         return voxelizer.readVoxels();
     }
-
-    std::unique_ptr<vk::Context> m_ctx;
 };
 
 /** 32^3 grid with 1-unit voxels: world = grid coordinates. */
