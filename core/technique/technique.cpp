@@ -37,6 +37,11 @@ PassScope::~PassScope() {
     if (m_timer) m_timer->end(m_cmd);
 }
 
+int claimedBounces(const TechniqueInfo& info, const ParamSet& params) {
+    if (info.bouncesParam.empty()) return info.indirectBounces;
+    return params.getInt(info.bouncesParam);
+}
+
 SupportResult Technique::checkSupport(const Scene& scene, const ParamSet&) const {
     const FeatureSupport& s = m_info.supports;
     const SceneCaps& caps = scene.caps;

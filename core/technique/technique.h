@@ -55,8 +55,14 @@ struct TechniqueInfo {
     std::string citation;     // the paper it implements ("" for the baseline)
     std::vector<ParamSpec> params;
     int indirectBounces = 0;  // 0 = direct only, n >= 1, or kAllBounces
+    /** When set, the int parameter whose value is the claimed bounce count (e.g. dvs "bounces");
+     *  indirectBounces is then its default. Use claimedBounces() to read it. */
+    std::string bouncesParam;
     FeatureSupport supports;
 };
+
+/** The indirect bounces a technique claims with these parameter values (TechniqueInfo). */
+int claimedBounces(const TechniqueInfo& info, const ParamSet& params);
 
 struct SupportResult {
     bool supported = true;

@@ -58,9 +58,10 @@ int runRender(const RenderOptions& options) {
     meta["provenance"] = provenanceJson(options.commandLine);
     meta["device"] = deviceJson(ctx);
     meta["scene"] = sceneToJson(scene);
-    meta["technique"] = {{"id", options.technique},
-                         {"indirect_bounces", registry.get(options.technique).indirectBounces},
-                         {"params", params.toOrderedJson()}};
+    meta["technique"] = {
+        {"id", options.technique},
+        {"indirect_bounces", claimedBounces(registry.get(options.technique), params)},
+        {"params", params.toOrderedJson()}};
     meta["shared_params"] = shared.toOrderedJson();
 
     FrameHarness harness(ctx, scene, options.technique, params, shared);

@@ -79,4 +79,22 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
     return out;
 }
 
+nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers,
+                                           const ReferenceSet& references,
+                                           const MetricOptionsSpec& spec, const ToneMap& tonemap) {
+    const Image& final = layerImage(layers, "final");
+    metrics::MetricOptions options;
+    options.tonemap = tonemap;
+    options.ppd = spec.ppd;
+    options.resampleFlip = false;
+    nlohmann::ordered_json out;
+    for (int bounces : {0, 1, 2}) {
+        const MatchedReference matched = references.match(bounces);
+        options.referenceStdError = &matched.finalStdError;
+        out[std::to_string(bounces)] =
+            metrics::toJson(metrics::computeMetrics(final, matched.final, options));
+    }
+    return out;
+}
+
 }  // namespace gilab::exp

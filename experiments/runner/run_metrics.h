@@ -22,4 +22,13 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
                                          const MetricOptionsSpec& spec, const ToneMap& tonemap,
                                          const std::filesystem::path& outDir);
 
+/**
+ * The final image against the references with 0, 1 and 2 indirect bounces, whatever the
+ * technique claims: {"0": M, "1": M, "2": M}. Puts every technique, the direct baseline
+ * included, on the same footing as a one- or two-bounce technique (report, done criteria).
+ */
+nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers,
+                                           const ReferenceSet& references,
+                                           const MetricOptionsSpec& spec, const ToneMap& tonemap);
+
 }  // namespace gilab::exp

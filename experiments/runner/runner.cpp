@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /** Bumped when the meaning of a run's result changes, so finished runs are redone. */
-constexpr int kRunFormatVersion = 1;
+constexpr int kRunFormatVersion = 2;  // 2: metrics.final_vs_bounces
 
 /** Loads each scene of the experiment once, applying the config's resolution. */
 class SceneCache {
@@ -145,7 +145,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["technique"] = {{"id", info.id},
                            {"description", info.description},
                            {"citation", info.citation},
-                           {"indirect_bounces", info.indirectBounces},
+                           {"indirect_bounces", claimedBounces(info, run.params)},
                            {"params", run.params.toOrderedJson()},
                            {"swept", swept}};
     result["shared_params"] = run.shared.toOrderedJson();
@@ -164,7 +164,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     }
 
     const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
-    const MatchedReference matched = refs.match(info.indirectBounces);
+    const MatchedReference matched = refs.match(claimedBounces(info, run.params));
     ToneMap tm;
     tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
     result["reference"] = {{"key", refs.result().key},
@@ -193,8 +193,9 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["memory"] = cli::memoryJson(harness.memory());
     result["skipped_passes"] = harness.skipped();
     result["notes"] = harness.notes();
-    result["metrics"] =
-        computeRunMetrics(layers, matched, info.indirectBounces, c.config.metrics, tm, tmp);
+    result["metrics"] = computeRunMetrics(layers, matched, claimedBounces(info, run.params),
+                                          c.config.metrics, tm, tmp);
+    result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
     result["validation"] = {{"errors", c.vk.validationErrorCount()},
                             {"warnings", c.vk.validationWarningCount()}};
 

@@ -21,8 +21,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import report_figures  # noqa: E402
-from report_analysis import (MATCHED, Basis, by_scene, by_technique, best_run,  # noqa: E402
-                             find_sweeps, pareto_fronts, pass_colors, ranking_basis, slug,
+from report_analysis import (MATCHED, ONE_BOUNCE, Basis, by_scene, by_technique,  # noqa: E402
+                             best_run, find_sweeps, has_one_bounce, pareto_fronts, pass_colors, ranking_basis, slug,
                              technique_colors)
 from report_data import Results, load_results  # noqa: E402
 from report_common import Figures, Page  # noqa: E402
@@ -54,6 +54,10 @@ def clear_old_figures(fig_dir: str) -> None:
         os.remove(path)
 
 
+# The zero point every sweep figure shows as a dashed line (the direct-light baseline).
+BASELINE_TECHNIQUE = "direct"
+
+
 def write_figures(results: Results, colors: dict[str, str], bases: list[Basis],
                   fig_dir: str) -> Figures:
     """Draws every figure that applies; returns their paths."""
@@ -79,7 +83,12 @@ def write_figures(results: Results, colors: dict[str, str], bases: list[Basis],
     for sweep in find_sweeps(runs):
         name = f"sweep_{slug(sweep.technique)}_{slug(sweep.scene)}_{slug(sweep.key)}.svg"
         path = os.path.join(fig_dir, name)
-        report_figures.sweep_figure(sweep, colors, path)
+        baseline = None
+        if sweep.technique != BASELINE_TECHNIQUE:
+            direct = [r for r in runs if r.scene == sweep.scene
+                      and r.technique == BASELINE_TECHNIQUE]
+            baseline = best_run(direct)
+        report_figures.sweep_figure(sweep, colors, path, baseline)
         figures.sweeps.append((sweep, path))
     return figures
 
@@ -97,7 +106,8 @@ def build_report(dirs: list[str], out_dir: str) -> str:
     os.makedirs(out_dir, exist_ok=True)
     colors = technique_colors([r.technique for r in results.runs])
     basis = ranking_basis(results.runs)
-    bases = [MATCHED] + ([basis] if basis is not MATCHED else [])
+    bases = [MATCHED] + ([ONE_BOUNCE] if has_one_bounce(results.runs) else []) + (
+        [basis] if basis is not MATCHED else [])
     figures = write_figures(results, colors, bases, os.path.join(out_dir, "figures"))
     fronts = {scene: pareto_fronts(rs, basis) for scene, rs in by_scene(results.runs).items()}
     page = Page(out_dir=out_dir, results=results, colors=colors, figures=figures, basis=basis,

@@ -9,7 +9,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from report_data import Run, num, text
+from report_data import MetricView, Run, num, text
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
 TECHNIQUE_PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
@@ -155,6 +155,37 @@ MATCHED = Basis("matched", "vs. the bounce-matched reference", lambda r: r.final
 FULL = Basis("full", "vs. the full reference (all light paths)", lambda r: r.vs_full.flip_mean,
              lambda r: r.vs_full.flip_sigma, lambda r: r.vs_full.rel_mse,
              lambda r: r.vs_full.rel_mse_sigma, lambda r: "full")
+
+
+def _one_bounce(run: Run) -> MetricView:
+    return run.vs_bounces.get("1") or MetricView()
+
+
+ONE_BOUNCE = Basis("one_bounce", "vs. the one-bounce reference (emission + direct + bounce 1)",
+                   lambda r: _one_bounce(r).flip_mean, lambda r: _one_bounce(r).flip_sigma,
+                   lambda r: _one_bounce(r).rel_mse, lambda r: _one_bounce(r).rel_mse_sigma,
+                   lambda r: "emission+direct+bounce1")
+
+
+def has_one_bounce(runs: list[Run]) -> bool:
+    """Whether a one-bounce technique ran next to others (then every run is also ranked against
+    the one-bounce reference, so `direct` and 1-bounce GI share one yardstick)."""
+    measured = [r for r in runs if r.measured]
+    return (any(r.claimed_bounces == 1 for r in measured)
+            and any(r.claimed_bounces != 1 for r in measured)
+            and any(ONE_BOUNCE.flip(r) is not None for r in measured))
+
+
+def baseline_value(baseline: Optional[Run], bounces: Optional[int],
+                   metric: Callable[[MetricView], Optional[float]]) -> Optional[float]:
+    """`metric` of the baseline run against the reference with `bounces` indirect bounces
+    (the full reference for -1 / None)."""
+    if baseline is None:
+        return None
+    if bounces is None or bounces < 0 or bounces > 2:
+        return metric(baseline.vs_full)
+    view = baseline.vs_bounces.get(str(bounces))
+    return metric(view) if view is not None else None
 
 
 def ranking_basis(runs: list[Run]) -> Basis:

@@ -142,6 +142,10 @@ class Run:
     frame_source: str  # "gpu", "cpu" or ""
     setup_ms: Optional[float]
     date: str
+    # metrics.final_vs_bounces: "0", "1", "2" -> the final image against the reference with that
+    # many indirect bounces, whatever the technique claims (puts `direct` next to 1-bounce GI)
+    vs_bounces: dict = field(default_factory=dict)
+    claimed_bounces: Optional[int] = None  # technique.indirect_bounces (-1 = all)
 
     @property
     def measured(self) -> bool:
@@ -249,6 +253,11 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
         frame_source=source,
         setup_ms=num(dig(data, "timing", "setup_ms", "total")),
         date=text(dig(data, "provenance", "date")),
+        vs_bounces={text(k): MetricView.parse(v)
+                    for k, v in _as_dict(dig(data, "metrics", "final_vs_bounces")).items()},
+        claimed_bounces=(int(num(dig(data, "technique", "indirect_bounces")))
+                         if num(dig(data, "technique", "indirect_bounces")) is not None
+                         else None),
     )
 
 

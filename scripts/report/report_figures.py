@@ -15,8 +15,8 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
-from report_analysis import (GREYS, Basis, Sweep, param_value, pareto_fronts,  # noqa: E402
-                             shade, sweep_x)
+from report_analysis import (GREYS, Basis, Sweep, baseline_value, param_value,  # noqa: E402
+                             pareto_fronts, shade, sweep_x)
 from report_data import Run, text  # noqa: E402
 
 STYLE = {
@@ -193,18 +193,34 @@ def _sweep_panel(ax: plt.Axes, sweep: Sweep, color: str, value: Metric, sigma: M
     ax.set_xlabel(sweep.key)
 
 
-def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str) -> None:
-    """Mean FLIP, relMSE and frame time against the swept parameter (three panels)."""
+def _sweep_bounces(sweep: Sweep) -> Optional[int]:
+    """The bounce count the swept runs claim, if they all claim the same."""
+    claimed = {r.claimed_bounces for members in sweep.series.values() for r in members}
+    return claimed.pop() if len(claimed) == 1 else None
+
+
+def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str,
+                 baseline: Optional[Run] = None) -> None:
+    """Mean FLIP, relMSE and frame time against the swept parameter (three panels); with a
+    baseline run (`direct`), its error against the same reference and its frame time as a
+    dashed line."""
     positions, categories = _sweep_positions(sweep)
     color = colors[sweep.technique]
     fig, axes = plt.subplots(1, 3, figsize=(11.0, 3.3), gridspec_kw={"wspace": 0.32})
+    bounces = _sweep_bounces(sweep)
     panels = (
-        (lambda r: r.final.flip_mean, lambda r: r.final.flip_sigma, "mean FLIP (HDR-FLIP) ↓"),
-        (lambda r: r.final.rel_mse, lambda r: r.final.rel_mse_sigma, "relMSE ↓"),
-        (lambda r: r.frame_ms, lambda r: None, "median frame time [ms]"),
+        (lambda r: r.final.flip_mean, lambda r: r.final.flip_sigma, "mean FLIP (HDR-FLIP) ↓",
+         baseline_value(baseline, bounces, lambda m: m.flip_mean)),
+        (lambda r: r.final.rel_mse, lambda r: r.final.rel_mse_sigma, "relMSE ↓",
+         baseline_value(baseline, bounces, lambda m: m.rel_mse)),
+        (lambda r: r.frame_ms, lambda r: None, "median frame time [ms]",
+         baseline.frame_ms if baseline is not None else None),
     )
-    for ax, (value, sigma, label) in zip(axes, panels):
+    for ax, (value, sigma, label, base) in zip(axes, panels):
         _sweep_panel(ax, sweep, color, value, sigma, positions, label)
+        if base is not None and baseline is not None:
+            ax.axhline(base, ls="--", lw=1.0, color=colors.get(baseline.technique, "#777777"),
+                       label=f"{baseline.technique} (same reference)")
         if categories:
             ax.set_xticks(range(len(categories)), categories)
         elif _wants_log(list(positions.values())):
@@ -217,7 +233,7 @@ def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str) -> None:
     if any(r.status == "nonfinite" for m in sweep.series.values() for r in m):
         extra = [Line2D([], [], marker="X", ls="none", color="#999999", mec="black",
                         label="nonfinite output")]
-    if len(handles) > 1 or extra:
+    if len(handles) > 1 or extra or baseline is not None:
         fig.legend(handles=handles + extra, loc="upper center",
                    ncol=min(len(handles) + len(extra), 6), bbox_to_anchor=(0.5, -0.04),
                    frameon=False)

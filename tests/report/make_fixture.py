@@ -118,6 +118,12 @@ def flip_vs_full(spec: Spec) -> float:
     return flip_of(spec) + missing * scene_factor(spec.scene)
 
 
+def flip_vs_bounces(spec: Spec, n: int) -> float:
+    """Against the reference with n indirect bounces: each bounce a technique lacks adds error."""
+    missing = max(0, n - bounces(spec.technique)) * 0.12 + max(0, bounces(spec.technique) - n) * 0.05
+    return flip_of(spec) + missing * scene_factor(spec.scene)
+
+
 def region_metrics(spec: Spec, flip: float, pixels: int, bars: bool) -> dict:
     entry = {"pixels": pixels, "final": metric_set(flip, pixels, bars)}
     if bounces(spec.technique):
@@ -352,6 +358,10 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
         if sweeps:  # the runner writes it; the flat fixture checks the report without it
             metrics["final_vs_full"] = metric_set(flip_vs_full(spec), w * h, bars,
                                                   spec.nan_pixels, flip_resampled=False)
+            # against the 0/1/2-bounce references: the baseline misses bounce 1 against "1"
+            metrics["final_vs_bounces"] = {
+                str(n): metric_set(flip_vs_bounces(spec, n), w * h, bars, spec.nan_pixels,
+                                   flip_resampled=False) for n in (0, 1, 2)}
         if bounces(spec.technique):
             metrics["indirect"] = metric_set(min(1.0, flip * 1.8), w * h, bars, spec.nan_pixels)
         if sweeps and spec.scene == "cornell_box":

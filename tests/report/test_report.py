@@ -162,6 +162,7 @@ def pareto_rows(results_dir: str) -> set[str]:
                 svg = f.read()
             rows |= {"matched"} if "bounce-matched reference" in svg else set()
             rows |= {"full"} if "full reference" in svg else set()
+            rows |= {"one_bounce"} if "one-bounce reference" in svg else set()
     return rows
 
 
@@ -232,8 +233,13 @@ def check_main(checks: Checks, tmp: str) -> None:
                   "flip_indirect"} <= set(cols),
                  "region, within-noise, Pareto, vs-full and indirect columns are present",
                  str(cols))
-    checks.check(pareto_rows(fixture) == {"matched", "full"},
-                 "error-vs-time figures have a matched and a full-reference row")
+    checks.check(pareto_rows(fixture) == {"matched", "one_bounce", "full"},
+                 "error-vs-time figures have a matched, a one-bounce and a full-reference row")
+    sweep_svgs = [s for s in svgs if s.startswith("sweep_tech_a_")]
+    checks.check(bool(sweep_svgs) and all(
+        "direct (same reference)" in open(os.path.join(fixture, "figures", s),
+                                          encoding="utf-8").read() for s in sweep_svgs),
+        "sweep figures show the direct baseline against the same reference")
     flip_cells = [a for tag, a in items if tag == "td" and has_class(a, "c-flip")]
     checks.check(len(flip_cells) == expected and "±" in dom, "FLIP column with error bars")
     images = [a for tag, a in items if tag == "img" and a.get("src", "").startswith("runs/")]
