@@ -1,0 +1,67 @@
+// Declarations of the octree's build and injection passes (techniques/vct/svo.cpp).
+// Set 0: 0 SvoInfo (uniform), 1 node pool, 2 counters (0 nodes, 1 bricks, 2 overflow, 3 -, then
+// per depth d: 4 + 2d first node, 5 + 2d end), 3 occupancy bits (pyramid, one bit per cell),
+// 4 flux accumulators (3 words per leaf brick sample; float bits or fixed point), 5 radiance
+// brick pool, 6 geometry brick pool. Set 1: the voxelizer's albedoOpacity. Set 2: photons.
+#ifndef GILAB_VCT_SVO_COMMON_GLSL
+#define GILAB_VCT_SVO_COMMON_GLSL
+
+#include "vct/photon.glsl"
+#include "vct/svo_info.glsl"
+
+layout(set = 0, binding = 0, std140) uniform SvoInfoBlock {
+    SvoInfo svo;
+};
+layout(set = 0, binding = 1, std430) buffer SvoNodes {
+    uint svoNodes[];
+};
+layout(set = 0, binding = 2, std430) buffer SvoCounters {
+    uint svoCounters[];
+};
+layout(set = 0, binding = 3, std430) buffer SvoOccupancy {
+    uint svoOccupancy[];
+};
+#ifdef SVO_FLOAT_ACCUM
+layout(set = 0, binding = 4, std430) buffer SvoAccum {
+    float svoAccum[];
+};
+#else
+layout(set = 0, binding = 4, std430) buffer SvoAccum {
+    uint svoAccum[];
+};
+#endif
+layout(set = 0, binding = 5, rgba16f) uniform image3D svoRadiance;
+layout(set = 0, binding = 6, rgba16f) uniform image3D svoGeometry;
+
+#define SVO_NODE(i) svoNodes[i]
+#define SVO_INFO svo
+#include "vct/svo_tree.glsl"
+
+// x depth, y axis (0..2), z pass / sub-mode, w target (0 accumulators, 1 radiance, 2 geometry)
+layout(push_constant, std430) uniform SvoPush {
+    uvec4 args;
+    vec4 scale;  // x fixed-point units per W, y W per unit, z 1 / (pi v0^2)
+} pc;
+
+uint svoLevelBegin(uint depth) { return svoCounters[4u + 2u * depth]; }
+uint svoLevelEnd(uint depth) { return svoCounters[5u + 2u * depth]; }
+
+bool svoOccupied(uint depth, uvec3 c) {
+    uint n = svo.depthInfo[depth].y;
+    uint idx = c.x + n * (c.y + n * c.z);
+    return ((svoOccupancy[svo.depthInfo[depth].x + (idx >> 5)] >> (idx & 31u)) & 1u) != 0u;
+}
+
+int svoSampleIndex(ivec3 s) { return s.x + 3 * (s.y + 3 * s.z); }
+
+vec4 svoLoad(uint target, ivec3 texel) {
+    return target == 2u ? imageLoad(svoGeometry, texel) : imageLoad(svoRadiance, texel);
+}
+void svoStore(uint target, ivec3 texel, vec4 v) {
+    if (target == 2u)
+        imageStore(svoGeometry, texel, v);
+    else
+        imageStore(svoRadiance, texel, v);
+}
+
+#endif  // GILAB_VCT_SVO_COMMON_GLSL

@@ -1,0 +1,29 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Octree build, step 5: leaf geometry bricks (Crassin §4.2.2): sample s of leaf cell n is the
+// voxel 2n + s of the voxelizer's volume (its centre), stored as (a * albedo, a); samples past
+// the grid are empty. Neighbouring bricks read the same voxel for a shared sample, so the
+// duplicates agree without a transfer.
+#include "vct/svo_common.glsl"
+
+layout(set = 1, binding = 0) uniform sampler3D voxelAlbedoOpacity;
+layout(local_size_x = 64) in;
+
+void main() {
+    uint d = svo.dims.y;
+    uint t = gl_GlobalInvocationID.x;
+    uint node = svoLevelBegin(d) + t / 27u;
+    if (node >= svoLevelEnd(d)) return;
+    uint brick = svoWord(node, SVO_W_BRICK);
+    if (brick == SVO_NONE) return;
+    int k = int(t % 27u);
+    ivec3 s = ivec3(k % 3, (k / 3) % 3, k / 9);
+    ivec3 v = 2 * ivec3(svoUnpackCoord(svoWord(node, SVO_W_COORD))) + s;
+    vec4 g = vec4(0.0);
+    if (all(lessThan(v, ivec3(svo.dims.x)))) {
+        vec4 ao = texelFetch(voxelAlbedoOpacity, v, 0);
+        float a = clamp(ao.a, 0.0, 1.0);
+        g = vec4(max(ao.rgb, vec3(0.0)) * a, a);
+    }
+    imageStore(svoGeometry, svoBrickOrigin(brick) + s, g);
+}

@@ -1,0 +1,66 @@
+// voxelConeSample for the sparse voxel octree (techniques/vct/svo.h, docs/vct_svo.md; Crassin
+// §5, notes 001 §2.9): quadrilinear lookup = trilinear inside the vertex-centred brick of the node
+// whose level matches the lod (hardware linear filter on the brick pool: the brick's samples are
+// texel centres, so a position inside the node never leaves its brick), linear between the
+// levels floor(lod) and floor(lod) + 1. Descends from the root each time; stops at a collapsed
+// node (empty space -> vec4(0)). Isotropic: `dir` is unused.
+// Before including, define SVO_SET and SVO_BINDING (layout as
+// SparseVoxelOctree::addLayoutBindings: +0 SvoInfo uniform, +1 node pool, +2 radiance bricks).
+#ifndef GILAB_VCT_SVO_SAMPLE_GLSL
+#define GILAB_VCT_SVO_SAMPLE_GLSL
+
+#include "vct/svo_info.glsl"
+
+#if !defined(SVO_SET) || !defined(SVO_BINDING)
+#error "define SVO_SET and SVO_BINDING before including svo_sample.glsl"
+#endif
+
+layout(set = SVO_SET, binding = SVO_BINDING, std140) uniform SvoSampleInfo {
+    SvoInfo svoInfo;
+};
+layout(set = SVO_SET, binding = SVO_BINDING + 1, std430) readonly buffer SvoSampleNodes {
+    uint svoSampleNodes[];
+};
+layout(set = SVO_SET, binding = SVO_BINDING + 2) uniform sampler3D svoRadiancePool;
+
+#define SVO_NODE(i) svoSampleNodes[i]
+#define SVO_INFO svoInfo
+#include "vct/svo_tree.glsl"
+
+// Level l sample (spacing v0 2^l) at grid position g (voxel units, centres at i + 0.5).
+vec4 svoSampleLevel(vec3 g, uint level) {
+    uint leafDepth = svoInfo.dims.y;
+    uint depth = leafDepth - level;
+    float n = float(svoInfo.dims.x);
+    // Level-l lattice coordinate: sample s sits at grid position s 2^l + 0.5 (clamp to edge
+    // below the first voxel centre, as the dense volumes' sampler does).
+    vec3 u = clamp(g - 0.5, vec3(0.0), vec3(n)) / float(1u << level);
+    uint cells = 1u << depth;
+    uvec3 cell = min(uvec3(floor(u * 0.5)), uvec3(cells - 1u));
+    uint node = svoFindNode(cell, depth);
+    if (node == SVO_NONE) return vec4(0.0);
+    uint brick = svoWord(node, SVO_W_BRICK);
+    if (brick == SVO_NONE) return vec4(0.0);
+    vec3 local = clamp(u - 2.0 * vec3(cell), vec3(0.0), vec3(2.0));
+    vec3 texel = vec3(svoBrickOrigin(brick)) + 0.5 + local;
+    return textureLod(svoRadiancePool, texel / vec3(textureSize(svoRadiancePool, 0)), 0.0);
+}
+
+vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
+    vec3 g = (worldPos - svoInfo.originVoxelSize.xyz) / svoInfo.originVoxelSize.w;
+    float n = float(svoInfo.dims.x);
+    if (any(lessThan(g, vec3(0.0))) || any(greaterThan(g, vec3(n)))) return vec4(0.0);
+    float maxLevel = float(svoInfo.dims.y);
+    lod = clamp(lod, 0.0, maxLevel);
+    uint l0 = uint(floor(lod));
+    float f = lod - float(l0);
+    vec4 s = svoSampleLevel(g, l0);
+    if (f > 0.0 && l0 < svoInfo.dims.y) s = mix(s, svoSampleLevel(g, l0 + 1u), f);
+    s = max(s, vec4(0.0));
+    if (!(s.a > 0.0)) return vec4(0.0);
+    return vec4(s.rgb, min(s.a, 1.0));
+}
+
+#include "common/voxel_cone.glsl"
+
+#endif  // GILAB_VCT_SVO_SAMPLE_GLSL

@@ -1,0 +1,132 @@
+#pragma once
+/**
+ * Sparse voxel octree storage of `vct` (Crassin et al. 2011 §4, notes 001 §2.1-2.3, §2.6-2.7,
+ * docs/vct_svo.md). Node pool of 2x2x2 tiles (one child-tile pointer per node, brick pointer,
+ * +-x/y/z neighbour pointers, parent pointer); brick pool of vertex-centred 3x3x3 bricks (opacity
+ * + premultiplied radiance, alpha-premultiplied albedo). Leaf bricks sample the voxelizer's N^3
+ * volumes at voxel centres (spacing v0); level l bricks have spacing v0 2^l and are filtered with
+ * the 3^3 Gaussian. Empty nodes are collapsed (no children, no brick).
+ *
+ * Pools are sized in the constructor from a conservative CPU bound of the occupied leaf cells
+ * (triangle / cell overlap on the scene's triangles, dilated by one voxel), so build() and
+ * inject() only record into the caller's command buffer. Isotropic voxels only.
+ */
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+#include "core/technique/technique.h"
+#include "core/vk/buffer.h"
+#include "core/vk/descriptors.h"
+#include "core/vk/image.h"
+#include "core/vk/pipeline.h"
+#include "core/vk/sampler.h"
+#include "core/voxel/voxel_grid.h"
+#include "core/voxel/voxelizer.h"
+#include "techniques/vct/photons.h"
+
+namespace gilab::vct {
+
+/** Mirrors SvoInfo in shaders/vct/svo_common.glsl (uniform buffer, std140). */
+struct GpuSvoInfo {
+    glm::vec4 originVoxelSize;  // grid minimum corner, w = v0
+    glm::uvec4 dims;      // x N, y leaf depth D (root depth 0), z pool bricks along x, w levels
+    glm::uvec4 capacity;  // x node capacity, y brick capacity, z float atomics, w bricks along y
+    glm::uvec4 depthInfo[16];  // per depth d: x occupancy word offset, y cells per axis (2^d),
+                               // z bound on the nodes of depth d, w -
+};
+static_assert(sizeof(GpuSvoInfo) == 304);
+
+class SparseVoxelOctree {
+public:
+    SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid);
+    SparseVoxelOctree(const SparseVoxelOctree&) = delete;
+    SparseVoxelOctree& operator=(const SparseVoxelOctree&) = delete;
+
+    /** Set-up: nodes + bricks from the voxelizer's volumes (geometry in the leaves, filtered up).
+     */
+    void build(TechniqueContext& ctx, VkCommandBuffer cmd, VoxelVolumes& voxels);
+    /** Clears the radiance bricks, splats the photons into the leaves, border transfer, shade,
+     *  filter up. */
+    void inject(TechniqueContext& ctx, VkCommandBuffer cmd, const PhotonSource& photons);
+    /** Bindings first .. first+2: tree info (uniform buffer), node pool (storage buffer),
+     *  radiance brick pool (combined image sampler); see shaders/vct/svo_sample.glsl. */
+    static void addLayoutBindings(std::vector<VkDescriptorSetLayoutBinding>& out, uint32_t first,
+                                  VkShaderStageFlags stages);
+    void writeDescriptors(vk::DescriptorSet& set, uint32_t first) const;
+    static constexpr uint32_t kBindingCount = 3;
+
+    struct Memory {
+        size_t nodeBytes = 0, brickBytes = 0;
+        uint32_t nodeCount = 0, brickCount = 0;
+        size_t total() const { return nodeBytes + brickBytes; }
+        /** Not in total(): flux accumulators (3 words per leaf sample), occupancy pyramid
+         *  (set-up scratch, 1 bit per cell), counters and the info block. */
+        size_t scratchBytes = 0;
+    };
+    /** Allocated pools (capacity from the CPU bound): bytes of the node pool and brick pools. */
+    Memory memory() const;
+    /** Nodes and bricks the GPU build actually allocated (blocking read-back; not inside a
+     *  submission). Bytes = used count x bytes per node / brick. */
+    Memory usedMemory() const;
+    static const char* gatherShaderName() { return "vct/svo_gather.comp"; }
+
+    // Introspection for tests and docs.
+    static constexpr uint32_t kNodeWords = 12;  // child, brick, parent, nbr[6], flags, pad
+    static constexpr uint32_t kBrickSamples = 27;
+    const VoxelGrid& grid() const { return m_grid; }
+    uint32_t leafDepth() const { return m_leafDepth; }
+    uint32_t levelCount() const { return m_leafDepth + 1; }
+    const GpuSvoInfo& info() const { return m_info; }
+    /** Raw node pool (kNodeWords uint per node) and the allocation counters (tests). */
+    std::vector<uint32_t> readNodes() const;
+    /** Radiance brick pool texels (RGBA, brickSampleIndex order, tests). */
+    std::vector<glm::vec4> readRadianceBricks() const;
+    std::vector<glm::vec4> readGeometryBricks() const;
+    /** Brick texel position of sample (i,j,k) of brick b in the pool texture. */
+    glm::uvec3 brickTexel(uint32_t brick, glm::uvec3 sample) const;
+
+    /** Fixed-point scale (units per W) of the flux accumulators without float atomics. */
+    void setFixedPointScale(double unitsPerWatt) { m_fixedScale = unitsPerWatt; }
+    bool usesFloatAtomics() const { return m_floatAtomics; }
+    /** Bytes per node and per brick (radiance + geometry pools). */
+    static constexpr size_t kNodeBytes = kNodeWords * 4;
+    static constexpr size_t kBrickBytes = kBrickSamples * 8 * 2;
+
+private:
+    void createPipelines();
+    void bindAndDispatch(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline,
+                         const glm::uvec4& args, uint32_t threads, bool voxelSet,
+                         bool photonSet) const;
+    void transfer(VkCommandBuffer cmd, uint32_t depth, uint32_t target) const;
+    void filterUp(VkCommandBuffer cmd, uint32_t target) const;
+
+    vk::Context* m_vk = nullptr;
+    VoxelGrid m_grid;
+    uint32_t m_leafDepth = 0;
+    uint32_t m_nodeCapacity = 0, m_brickCapacity = 0, m_bricksPerAxis = 0;
+    bool m_floatAtomics = false;
+    double m_fixedScale = 1048576.0;
+    GpuSvoInfo m_info{};
+    VkImageView m_voxelView = VK_NULL_HANDLE;
+    VkBuffer m_photonBuffer = VK_NULL_HANDLE;
+
+    vk::Buffer m_infoBuffer;  // GpuSvoInfo (uniform)
+    vk::Buffer m_nodes;       // node pool, kNodeWords uint per node
+    vk::Buffer m_counters;    // [0] nodes allocated, [1] bricks allocated, [2] overflow flag
+    vk::Buffer m_accum;       // photon flux per leaf brick sample (3 words, float or fixed)
+    vk::Buffer m_occupancy;   // set-up scratch: occupancy pyramid, one bit per cell
+    vk::Image m_radiance;     // brick pool: rgb premultiplied radiance, a opacity
+    vk::Image m_geometry;     // brick pool: rgb alpha * albedo, a opacity
+    vk::Sampler m_sampler;
+
+    vk::DescriptorSetLayout m_setLayout, m_voxelLayout, m_photonLayout;
+    vk::DescriptorSet m_set, m_voxelSet, m_photonSet;
+    vk::PipelineLayout m_layout;
+    vk::ComputePipeline m_occupancyLeaf, m_occupancyUp, m_buildLevel, m_neighbours, m_leafGeometry,
+        m_splat, m_transfer, m_shade, m_filter;
+};
+
+}  // namespace gilab::vct

@@ -1,0 +1,315 @@
+#include "techniques/vct/vct.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include <glm/glm.hpp>
+
+#include "core/gpu/gpu_scene.h"
+#include "core/passes/shared_passes.h"
+#include "core/scene/scene.h"
+#include "core/technique/registry.h"
+#include "core/util/error.h"
+#include "core/vk/barrier.h"
+#include "core/vk/context.h"
+#include "core/voxel/cone_set.h"
+#include "core/voxel/voxel_debug_view.h"
+#include "core/voxel/voxel_radiance.h"
+#include "core/voxel/voxelizer.h"
+#include "techniques/vct/light_injection.h"
+#include "techniques/vct/svo.h"
+
+namespace gilab {
+namespace {
+
+constexpr uint32_t kFlagSpecular = 1u, kFlagAo = 2u, kFlagAnisotropic = 4u;
+constexpr uint32_t kParamsBinding = 6;
+
+/** Mirrors GatherParams in shaders/vct/gather_inputs.glsl (std140, all vec4). */
+struct GpuGatherParams {
+    glm::vec4 gridMinV0;
+    glm::vec4 gridMaxStep;
+    glm::vec4 distances;
+    glm::vec4 misc;
+    GpuConeSet coneSet;
+    glm::vec4 cameraPosition;
+    glm::uvec4 sizeFlags;
+    glm::vec4 specular;
+    GpuVoxelGrid grid;
+};
+static_assert(sizeof(GpuGatherParams) == 4 * 16 + sizeof(GpuConeSet) + 3 * 16 + 32);
+
+std::string mib(size_t bytes) {
+    char text[32];
+    std::snprintf(text, sizeof(text), "%.2f MiB", double(bytes) / (1024.0 * 1024.0));
+    return text;
+}
+
+std::vector<vk::DescriptorBinding> toBindings(const std::vector<VkDescriptorSetLayoutBinding>& in) {
+    std::vector<vk::DescriptorBinding> out;
+    for (const VkDescriptorSetLayoutBinding& b : in)
+        out.push_back({b.binding, b.descriptorType, b.descriptorCount, b.stageFlags});
+    return out;
+}
+
+}  // namespace
+
+VctTechnique::VctTechnique() = default;
+VctTechnique::~VctTechnique() = default;
+
+TechniqueInfo VctTechnique::describe() {
+    TechniqueInfo info;
+    info.id = "vct";
+    info.description =
+        "Voxel cone tracing: photon injection from light-view maps into a voxel radiance "
+        "pyramid (dense or sparse octree), diffuse + specular cones per pixel; one bounce";
+    info.citation =
+        "C. Crassin, F. Neyret, M. Sainz, S. Green, E. Eisemann, \"Interactive Indirect "
+        "Illumination Using Voxel Cone Tracing\", Computer Graphics Forum 30(7), 2011";
+    info.indirectBounces = 1;
+    info.supports.pointLights = true;
+    info.supports.spotLights = true;
+    info.supports.directionalLights = true;
+    info.supports.emissiveSurfaces = false;  // the paper injects light-view maps of lights only
+    const ParamStage rebuild = ParamStage::Rebuild;
+    info.params = {
+        intParam("voxel_resolution", 128, 32, 512, "voxels",
+                 "voxels per grid axis (paper: 512^3 = 9 octree levels; 128 fits lavapipe)",
+                 rebuild),
+        enumParam("storage", "dense", {"dense", "octree"},
+                  "radiance storage: dense 3D textures with mips, or the paper's sparse voxel "
+                  "octree with 3^3 bricks",
+                  rebuild),
+        boolParam("anisotropic", true,
+                  "dense: 6 directional mip volumes (Crassin §9); off = isotropic mips with the "
+                  "3^3 Gaussian filter",
+                  rebuild),
+        intParam("light_map_resolution", 0, 0, 4096, "texels",
+                 "light-view map side per light view (0 = 2 x voxel_resolution, notes 001 §8)",
+                 rebuild),
+        intParam("diffuse_cones", 6, 1, 16, "",
+                 "diffuse cones: one along the normal + a ring (paper timings: 3)"),
+        floatParam("diffuse_aperture_deg", 60.0, 1.0, 179.0, "deg",
+                   "full apex angle of each diffuse cone"),
+        floatParam("diffuse_tilt_deg", 60.0, 0.0, 89.0, "deg",
+                   "angle of the ring cones from the normal"),
+        floatParam("step_factor", 0.5, 0.05, 2.0, "",
+                   "cone step d' = step_factor x cone diameter (notes 001 §8)"),
+        floatParam("max_distance", 1.0, 0.01, 2.0, "grid sides",
+                   "maximum cone length in units of the voxel grid's side"),
+        floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
+                   "cone origin offset along the surface normal, in finest voxels"),
+        floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "",
+                   "a cone stops when its accumulated opacity reaches this"),
+        boolParam("specular", true,
+                  "one specular cone along the mirrored view direction on glossy pixels"),
+        floatParam("specular_min_aperture_deg", 1.0, 0.1, 60.0, "deg",
+                   "narrowest specular cone (the roughness mapping is clamped to [this, 60])"),
+        boolParam("ao", false, "trace AO cones (debug view \"ao\"; not applied to the image)",
+                  rebuild),
+        floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
+                   "AO distance falloff lambda in f(r) = 1 / (1 + lambda r) (Crassin §6)"),
+    };
+    return info;
+}
+
+void VctTechnique::setup(TechniqueContext& ctx) {
+    const ParamSet& p = ctx.params;
+    const uint32_t n = uint32_t(p.getInt("voxel_resolution"));
+    if ((n & (n - 1)) != 0) {
+        throw Error("vct: voxel_resolution = " + std::to_string(n) +
+                    " must be a power of two (mip pyramid / octree levels)");
+    }
+    int mapRes = p.getInt("light_map_resolution");
+    if (mapRes == 0) mapRes = int(2 * n);
+    if (mapRes < 8) {
+        throw Error("vct: light_map_resolution = " + std::to_string(mapRes) +
+                    " must be 0 (auto) or >= 8");
+    }
+    m_octree = p.getEnum("storage") == "octree";
+    m_ao = p.getBool("ao");
+    if (!ctx.scene.caps.bounds.valid()) throw Error("vct: the scene has no geometry");
+
+    // Release the previous set-up's resources first (rebuild)
+    m_gather = {};
+    m_voxelView.reset();
+    m_svo.reset();
+    m_radiance.reset();
+    m_injection.reset();
+    m_voxelizer.reset();
+
+    m_grid = VoxelGrid(ctx.scene.caps.bounds, n);
+    m_voxelizer = std::make_unique<Voxelizer>(ctx.vk, ctx.gpuScene, m_grid);
+    m_injection = std::make_unique<vct::LightInjection>(ctx, m_grid, uint32_t(mapRes));
+    ctx.note("voxel grid " + std::to_string(n) + "^3, v0 = " + std::to_string(m_grid.voxelSize()) +
+             " m (paper: 512^3, 9 levels); light-view maps " + std::to_string(mapRes) + "^2 x " +
+             std::to_string(m_injection->viewCount()) +
+             " views = " + std::to_string(m_injection->photonCount()) + " photons");
+    ctx.note(
+        "lights are static: light is injected once at set-up (the paper re-injects when the "
+        "light moves)");
+    if (ctx.scene.lights.empty()) ctx.skip("inject", "scene has no punctual lights");
+
+    if (!m_octree) {
+        VoxelRadianceOptions options;
+        options.anisotropic = p.getBool("anisotropic");
+        options.isotropicFilter = VoxelMipFilter::Gaussian;
+        m_radiance = std::make_unique<VoxelRadiance>(ctx.vk, m_grid, options, ctx.tag("radiance"));
+        ctx.submitTimed([&](VkCommandBuffer cmd) {
+            m_voxelizer->record(cmd, ctx.timer);
+            {
+                PassScope pass(ctx, cmd, "inject");
+                m_injection->recordPhotons(ctx, cmd);
+                m_injection->recordSplat(ctx, cmd, m_voxelizer->volumes().albedoOpacity);
+                m_injection->recordShade(ctx, cmd, m_voxelizer->volumes().albedoOpacity,
+                                         m_radiance->base());
+            }
+            PassScope pass(ctx, cmd, "filter");
+            m_radiance->filter(cmd);
+        });
+        m_voxelizer->releaseAccumulators();
+        ctx.note("dense radiance (" +
+                 std::string(options.anisotropic ? "anisotropic" : "isotropic") +
+                 "): " + mib(m_radiance->memoryBytes()) + "; injection scratch " +
+                 mib(m_injection->memoryBytes()));
+        ctx.note(
+            "voxels store outgoing diffuse radiance (a albedo/pi E), not the paper's incoming "
+            "lobe: same result for Lambertian voxels, glossy secondary bounces are lost");
+        // The voxel debug view: rendered once (static camera and geometry)
+        m_voxelView = std::make_unique<VoxelDebugView>(ctx.vk, *m_voxelizer, ctx.width, ctx.height);
+        ctx.submitTimed([&](VkCommandBuffer cmd) {
+            m_voxelView->record(cmd, ctx.scene.camera, VoxelDebugMode::Albedo);
+        });
+    } else {
+        ctx.skip("anisotropic", "the octree stores isotropic voxels (3^3 Gaussian filter)");
+        m_svo = std::make_unique<vct::SparseVoxelOctree>(ctx, m_grid);
+        ctx.submitTimed([&](VkCommandBuffer cmd) {
+            m_voxelizer->record(cmd, ctx.timer);
+            {
+                PassScope pass(ctx, cmd, "svo_build");
+                m_svo->build(ctx, cmd, m_voxelizer->volumes());
+            }
+            PassScope pass(ctx, cmd, "inject");
+            m_injection->recordPhotons(ctx, cmd);
+            m_svo->inject(ctx, cmd, m_injection->photons());
+        });
+        m_voxelizer.reset();  // the octree holds everything the trace needs
+        const vct::SparseVoxelOctree::Memory mem = m_svo->memory();
+        const size_t dense = VoxelRadiance::memoryBytesFor(n, VoxelRadianceOptions{});
+        ctx.note("octree nodes " + mib(mem.nodeBytes) + " (" + std::to_string(mem.nodeCount) +
+                 ") + bricks " + mib(mem.brickBytes) + " (" + std::to_string(mem.brickCount) +
+                 "); a dense anisotropic pyramid at this resolution would take " + mib(dense));
+    }
+    if (!ctx.scene.caps.hasGlossy) {
+        ctx.skip("specular_cone", "scene has no glossy materials");
+    } else if (!p.getBool("specular")) {
+        ctx.skip("specular_cone", "specular = false");
+    }
+    if (!m_ao) ctx.skip("ao", "ao = false");
+    createGather(ctx);
+}
+
+void VctTechnique::createGather(TechniqueContext& ctx) {
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    vk::ImageDesc desc;
+    desc.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    desc.width = ctx.width;
+    desc.height = ctx.height;
+    desc.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
+    desc.name = ctx.tag("ao");
+    m_aoImage = vk::Image(ctx.vk, desc);
+    ctx.vk.submitAndWait([&](VkCommandBuffer cmd) {
+        m_aoImage.clearColor(cmd, VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}});
+    });
+    m_params = vk::Buffer(ctx.vk, sizeof(GpuGatherParams), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
+                          vk::MemoryUsage::Upload, ctx.tag("gather_params"));
+
+    std::vector<vk::DescriptorBinding> inputs;
+    for (uint32_t b = 0; b <= 5; ++b)
+        inputs.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs});
+    inputs.push_back({kParamsBinding, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, cs});
+    m_inputLayout = vk::DescriptorSetLayout(ctx.vk, inputs, ctx.tag("gather_inputs"));
+    m_inputSet = {};
+
+    std::vector<vk::DescriptorBinding> voxels;
+    if (m_octree) {
+        std::vector<VkDescriptorSetLayoutBinding> raw;
+        vct::SparseVoxelOctree::addLayoutBindings(raw, 0, cs);
+        voxels = toBindings(raw);
+    } else {
+        VoxelRadiance::addLayoutBindings(voxels, 0, cs);
+    }
+    m_voxelLayout = vk::DescriptorSetLayout(ctx.vk, voxels, ctx.tag("gather_voxels"));
+    m_voxelSet = vk::DescriptorSet(ctx.vk, m_voxelLayout, 0, ctx.tag("gather_voxels"));
+    if (m_octree) {
+        m_svo->writeDescriptors(m_voxelSet, 0);
+    } else {
+        m_radiance->writeDescriptors(m_voxelSet, 0);
+    }
+    m_gatherLayout =
+        vk::PipelineLayout(ctx.vk, {m_inputLayout.handle(), m_voxelLayout.handle()}, 0);
+    m_gather = vk::ComputePipeline(
+        ctx.vk, m_octree ? vct::SparseVoxelOctree::gatherShaderName() : "vct/gather_dense.comp",
+        m_gatherLayout);
+}
+
+void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) {
+    const ParamSet& p = ctx.params;
+    GBuffer& gb = ctx.shared.gbuffer();
+    // The frame images are stable for a harness; (re)write the inputs when the set is new
+    if (m_inputSet.handle() == VK_NULL_HANDLE) {
+        m_inputSet = vk::DescriptorSet(ctx.vk, m_inputLayout, 0, ctx.tag("gather_inputs"));
+        m_inputSet.writeStorageImage(0, gb.position.view());
+        m_inputSet.writeStorageImage(1, gb.normal.view());
+        m_inputSet.writeStorageImage(2, gb.albedo.view());
+        m_inputSet.writeStorageImage(3, gb.material.view());
+        m_inputSet.writeStorageImage(4, targets.indirect.view());
+        m_inputSet.writeStorageImage(5, m_aoImage.view());
+        m_inputSet.writeUniformBuffer(kParamsBinding, m_params);
+    }
+
+    const float v0 = m_grid.voxelSize();
+    const ConeSet cones =
+        makeDiffuseConeSet(uint32_t(p.getInt("diffuse_cones")), p.getFloat("diffuse_aperture_deg"),
+                           p.getFloat("diffuse_tilt_deg"));
+    uint32_t flags = 0;
+    if (p.getBool("specular") && ctx.scene.caps.hasGlossy) flags |= kFlagSpecular;
+    if (m_ao) flags |= kFlagAo;
+    if (!m_octree && m_radiance->options().anisotropic) flags |= kFlagAnisotropic;
+    GpuGatherParams g{};
+    g.gridMinV0 = glm::vec4(m_grid.origin(), v0);
+    g.gridMaxStep =
+        glm::vec4(m_grid.origin() + glm::vec3(m_grid.side()), p.getFloat("step_factor"));
+    g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
+                            p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
+    g.misc = glm::vec4(0.0f);
+    g.coneSet = toGpu(cones);
+    g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
+    g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
+    g.specular = glm::vec4(glm::radians(p.getFloat("specular_min_aperture_deg")),
+                           glm::radians(60.0f), p.getFloat("origin_offset") * v0, 0.0f);
+    g.grid = m_grid.gpu();
+    m_params.upload(&g, sizeof(g));
+
+    PassScope pass(ctx, cmd, "trace");
+    vk::memoryBarrier(cmd);  // G-buffer and the cleared indirect layer
+    m_gather.bind(cmd);
+    VkDescriptorSet sets[2] = {m_inputSet.handle(), m_voxelSet.handle()};
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_gatherLayout.handle(), 0, 2,
+                            sets, 0, nullptr);
+    vk::dispatch2D(cmd, ctx.width, ctx.height);
+    vk::memoryBarrier(cmd);
+}
+
+std::vector<DebugView> VctTechnique::debugViews() {
+    std::vector<DebugView> views;
+    if (m_ao && m_aoImage.valid()) views.push_back({"ao", &m_aoImage});
+    if (m_voxelView) views.push_back({"voxels", &m_voxelView->image()});
+    return views;
+}
+
+GILAB_REGISTER_TECHNIQUE(VctTechnique)
+
+}  // namespace gilab
