@@ -1,6 +1,7 @@
 // Stiff and extreme scenes (scenes/stress/*.json): every registered technique and the path
 // tracer must give finite, non-negative output on each, or skip with a reason. New techniques
 // are covered automatically through the registry.
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -41,6 +42,68 @@ void expectFiniteNonNegative(const Image& image, const std::string& what) {
 
 TEST(CpuStress, SceneSetIsPresent) {
     EXPECT_GE(stressScenes().size(), 6u);
+}
+
+/** Every value a per-frame parameter can be pushed to: its range limits and enum choices. */
+std::vector<std::string> extremeValues(const ParamSpec& spec) {
+    switch (spec.type) {
+        case ParamType::Bool:
+            return {"true", "false"};
+        case ParamType::Enum:
+            return spec.choices;
+        case ParamType::Int:
+        case ParamType::Float: {
+            std::vector<std::string> out;
+            for (double v : {spec.minValue, spec.maxValue})
+                if (std::isfinite(v))
+                    out.push_back(spec.type == ParamType::Int ? std::to_string(int(v))
+                                                              : std::to_string(v));
+            return out;
+        }
+    }
+    return {};
+}
+
+// Extreme parameter values (notes: narrow/wide cones, tiny steps, zero offsets, cutoffs): each
+// per-frame parameter of every technique at each limit, one at a time, on the thin wall between
+// a lit and a dark room (area light) and next to a point light close to a wall, on the coarsest
+// voxel grid.
+TEST(GpuStress, PerFrameParametersAtTheirLimitsStayFinite) {
+    vk::ContextOptions options;
+    options.validation = true;
+    vk::Context ctx(options);
+    size_t checked = 0;
+    for (const char* file : {"thin_wall_window.json", "point_light_near_wall.json"})
+        for (const TechniqueInfo* info : TechniqueRegistry::instance().list()) {
+            Scene scene = loadSmall(std::string(GILAB_SOURCE_DIR) + "/scenes/stress/" + file);
+            scene.settings.width = 16;
+            scene.settings.height = 16;
+            ParamSet base = TechniqueRegistry::instance().defaultParams(info->id);
+            if (base.has("voxel_resolution")) base.set("voxel_resolution", "32");
+            FrameHarness h(ctx, scene, info->id, base, defaultSharedParams());
+            if (!h.support().supported) continue;
+            h.setup();
+            for (const ParamSpec& spec : base.specs()) {
+                if (spec.stage != ParamStage::PerFrame) continue;
+                for (const std::string& value : extremeValues(spec)) {
+                    ParamSet p = base;
+                    p.set(spec.name, value);
+                    h.updateParams(p);
+                    h.renderFrame();
+                    const std::string what =
+                        info->id + " on " + file + ", " + spec.name + "=" + value;
+                    for (const ImageLayer& l : h.readLayers())
+                        if (l.name != "normal")
+                            expectFiniteNonNegative(l.image, what + " / " + l.name);
+                    ++checked;
+                }
+            }
+        }
+    EXPECT_GT(checked, 40u);
+    std::printf("checked %zu technique/parameter/value combinations\n", checked);
+    for (const std::string& m : ctx.validationMessages())
+        ADD_FAILURE() << m;
+    EXPECT_EQ(ctx.validationErrorCount(), 0u);
 }
 
 TEST(GpuStress, EveryTechniqueIsFiniteOrSkipsWithAReason) {

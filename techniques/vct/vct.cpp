@@ -101,6 +101,10 @@ TechniqueInfo VctTechnique::describe() {
                    "maximum cone length in units of the voxel grid's side"),
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
                    "cone origin offset along the surface normal, in finest voxels"),
+        floatParam("lod_offset", 0.0, -2.0, 2.0, "levels",
+                   "added to the cone's level log2(diameter / v0) (notes 001 §2.9); 0 = the "
+                   "paper's diameter-matched level, < 0 samples finer levels (less "
+                   "self-occlusion, more steps)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "",
                    "a cone stops when its accumulated opacity reaches this"),
         boolParam("specular", true,
@@ -284,7 +288,7 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
         glm::vec4(m_grid.origin() + glm::vec3(m_grid.side()), p.getFloat("step_factor"));
     g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
                             p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
-    g.misc = glm::vec4(0.0f);
+    g.misc = glm::vec4(p.getFloat("lod_offset"), 0.0f, 0.0f, 0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
     g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
