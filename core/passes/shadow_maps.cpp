@@ -1,5 +1,7 @@
 #include "core/passes/shadow_maps.h"
 
+#include "core/passes/light_view.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -17,36 +19,6 @@ constexpr float kNoOccluder = 3.0e38f;           // cleared distance: everything
 constexpr float kSpotMarginRad = 0.0872665f;     // 5 deg added to the spot map's fov
 constexpr float kMaxSpotFovRad = 2.9670597f;     // 170 deg
 constexpr float kCubeSpotOuterRad = 1.4835299f;  // outer cones above 85 deg use a cube
-
-/** Vulkan cube face axes (spec "Cube Map Face Selection"): s, t and the major axis. */
-struct CubeFace {
-    glm::vec3 s, t, m;
-};
-constexpr CubeFace kCubeFaces[6] = {
-    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}}, {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
-    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},   {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
-    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
-};
-
-/**
- * Cube face f seen from `eye`: clip = (s.q, t.q, near, m.q) with q = p - eye, so the framebuffer
- * (x, y) / size is exactly the face's (s, t) and depth = near / (m.q) is reversed-Z with an
- * infinite far plane.
- */
-glm::mat4 cubeFaceViewProj(const glm::vec3& eye, int face, float nearZ) {
-    const CubeFace& f = kCubeFaces[face];
-    glm::mat4 m(0.0f);
-    for (int i = 0; i < 3; ++i) {
-        m[i][0] = f.s[i];
-        m[i][1] = f.t[i];
-        m[i][3] = f.m[i];
-    }
-    m[3][0] = -glm::dot(f.s, eye);
-    m[3][1] = -glm::dot(f.t, eye);
-    m[3][2] = nearZ;
-    m[3][3] = -glm::dot(f.m, eye);
-    return m;
-}
 
 glm::vec3 upFor(const glm::vec3& dir) {
     return std::abs(dir.y) < 0.99f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0);
@@ -134,7 +106,9 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
         light.shadow = glm::vec4(float(kind), float(counter), texelFactor, 0.0f);
         for (int face = 0; face < 6; ++face) {
             Job job{kind, counter * 6 + uint32_t(face), base};
-            job.push.viewProj = cubeFaceViewProj(glm::vec3(light.positionType), face, nearZ);
+            const CubeFace& f = kCubeFaces[face];
+            job.push.viewProj =
+                pinholeViewProj(glm::vec3(light.positionType), f.m, f.s, f.t, 1.0f, nearZ);
             job.push.origin = glm::vec4(glm::vec3(light.positionType), 0.0f);
             m_jobs.push_back(job);
         }

@@ -1,5 +1,7 @@
 #include "techniques/vct/light_injection.h"
 
+#include "core/passes/light_view.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -25,38 +27,6 @@ struct InjectPush {
     glm::vec4 scale{0.0f};  // x units per W, y W per unit
     glm::uvec4 counts{0u};  // x photon count
 };
-
-/** Vulkan cube face axes (spec "Cube Map Face Selection"): s, t, major axis. */
-struct CubeFace {
-    glm::vec3 s, t, m;
-};
-constexpr CubeFace kCubeFaces[6] = {
-    {{0, 0, -1}, {0, -1, 0}, {1, 0, 0}}, {{0, 0, 1}, {0, -1, 0}, {-1, 0, 0}},
-    {{1, 0, 0}, {0, 0, 1}, {0, 1, 0}},   {{1, 0, 0}, {0, 0, -1}, {0, -1, 0}},
-    {{1, 0, 0}, {0, -1, 0}, {0, 0, 1}},  {{-1, 0, 0}, {0, -1, 0}, {0, 0, -1}},
-};
-
-/**
- * Pinhole view with image-plane axes ax, ay (scaled by tan(fov/2)) and forward f: clip =
- * (ax'.q, ay'.q, near, f.q) with ax' = ax / tan^2 ... written so that ndc = (x, y) / tanHalf where
- * (x, y) are the image-plane coordinates at unit distance; depth = near / (f.q), reversed Z with an
- * infinite far plane.
- */
-glm::mat4 pinholeViewProj(const glm::vec3& eye, const glm::vec3& f, const glm::vec3& x,
-                          const glm::vec3& y, float tanHalf, float nearZ) {
-    // ndc.x = (x.q) / (tanHalf f.q), ndc.y likewise, with x and y unit.
-    glm::mat4 m(0.0f);
-    for (int i = 0; i < 3; ++i) {
-        m[i][0] = x[i] / tanHalf;
-        m[i][1] = y[i] / tanHalf;
-        m[i][3] = f[i];
-    }
-    m[3][0] = -glm::dot(x, eye) / tanHalf;
-    m[3][1] = -glm::dot(y, eye) / tanHalf;
-    m[3][2] = nearZ;
-    m[3][3] = -glm::dot(f, eye);
-    return m;
-}
 
 /** Orthographic: ndc = (x.(p - c), y.(p - c)) / r; depth = 1 - distance from the entry plane /
  *  (2r) (reversed Z), entry plane through c - f r. */
