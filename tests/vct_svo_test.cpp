@@ -1,6 +1,7 @@
 // The sparse voxel octree of `vct` (techniques/vct/svo.h, docs/vct_svo.md) on hand-built scenes
 // with known answers: node counts, collapsed empty space, brick-border transfer, the 3^3
-// Gaussian, the cone sampler. Gpu* tests run with validation on and fail on any message.
+// Gaussian, the cone sampler, anisotropic (directional) bricks, split dispatches. Gpu* tests run
+// with validation on and fail on any message; Cpu* tests need no device.
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -43,6 +44,7 @@ namespace {
 
 using vct::GpuPhoton;
 using vct::SparseVoxelOctree;
+using Filter = SparseVoxelOctree::DirectionalFilter;
 constexpr uint32_t kNone = 0xFFFFFFFFu;
 constexpr float kPi = 3.14159265358979f;
 
@@ -96,18 +98,31 @@ protected:
         m_gpuScene.reset();
         test::ValidatedGpuTest::TearDown();
     }
-    /** Voxelizes `scene` into a 32^3 grid of unit voxels at the origin and builds the octree. */
-    void build(const Scene& scene, uint32_t n = 32) {
+    /** Voxelizes `scene` into a 32^3 grid of unit voxels at the origin and builds the octree.
+     *  maxGroups > 0: caps the work groups per dispatch dimension (forces 2D grids). */
+    void build(const Scene& scene, uint32_t n = 32, bool anisotropic = false,
+               uint32_t maxGroups = 0, Filter filter = Filter::Pairs) {
+        buildInGrid(scene, VoxelGrid::fromCube(glm::vec3(0.0f), float(n), n), anisotropic,
+                    maxGroups, filter);
+    }
+    void buildInGrid(const Scene& scene, const VoxelGrid& grid, bool anisotropic,
+                     uint32_t maxGroups = 0, Filter filter = Filter::Pairs) {
+        m_svo.reset();
+        m_voxelizer.reset();
+        m_tctx.reset();
+        m_shared.reset();
+        m_gpuScene.reset();
         m_scene = scene;
         m_gpuScene = std::make_unique<vk::GpuScene>(*m_ctx, m_scene);
         m_shared = std::make_unique<SharedPasses>(*m_ctx, *m_gpuScene, 32, 32);
         m_tctx = std::make_unique<TechniqueContext>(
             TechniqueContext{*m_ctx, m_scene, *m_gpuScene, *m_shared, m_params});
         m_tctx->techniqueId = "vct";
-        m_grid = VoxelGrid::fromCube(glm::vec3(0.0f), float(n), n);
+        m_grid = grid;
         m_voxelizer = std::make_unique<Voxelizer>(*m_ctx, *m_gpuScene, m_grid);
         m_voxelizer->run();
-        m_svo = std::make_unique<SparseVoxelOctree>(*m_tctx, m_grid);
+        m_svo = std::make_unique<SparseVoxelOctree>(*m_tctx, m_grid, anisotropic, filter);
+        if (maxGroups > 0) m_svo->setMaxDispatchGroupsForTesting(maxGroups);
         m_tctx->submitTimed(
             [&](VkCommandBuffer cmd) { m_svo->build(*m_tctx, cmd, m_voxelizer->volumes()); });
         m_tree.w = m_svo->readNodes();
@@ -127,9 +142,51 @@ protected:
         m_tctx->submitTimed([&](VkCommandBuffer cmd) { m_svo->inject(*m_tctx, cmd, src); });
         m_radiance = m_svo->readRadianceBricks();
     }
-    /** Every copy of level-`level` lattice sample `s` in the bricks of `pool`. */
+    /** voxelConeSample(q.xyz, lod q.w, dir) of every query on the GPU (svo_test_sample.comp). */
+    std::vector<glm::vec4> sample(const std::vector<glm::vec4>& queries, glm::vec3 dir) {
+        std::vector<glm::vec4> packed;
+        for (const glm::vec4& x : queries) {
+            packed.push_back(x);
+            packed.push_back(glm::vec4(dir, 0.0f));
+        }
+        vk::Buffer q(*m_ctx, packed.size() * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                     vk::MemoryUsage::Upload, "test/queries");
+        q.uploadVector(packed);
+        vk::Buffer r(*m_ctx, queries.size() * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                     vk::MemoryUsage::Readback, "test/results");
+        std::vector<VkDescriptorSetLayoutBinding> b;
+        SparseVoxelOctree::addLayoutBindings(b, 0, VK_SHADER_STAGE_COMPUTE_BIT);
+        std::vector<vk::DescriptorBinding> bindings;
+        for (const auto& x : b)
+            bindings.push_back({x.binding, x.descriptorType, 1, x.stageFlags});
+        vk::DescriptorSetLayout l0(*m_ctx, bindings, "test/svo");
+        vk::DescriptorSetLayout l1(
+            *m_ctx,
+            {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT},
+             {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT}},
+            "test/io");
+        vk::DescriptorSet s0(*m_ctx, l0), s1(*m_ctx, l1);
+        m_svo->writeDescriptors(s0, 0);
+        s1.writeBuffer(0, q);
+        s1.writeBuffer(1, r);
+        vk::PipelineLayout layout(*m_ctx, {l0.handle(), l1.handle()}, 4,
+                                  VK_SHADER_STAGE_COMPUTE_BIT);
+        vk::ComputePipeline pipe(*m_ctx, "vct/svo_test_sample.comp", layout);
+        m_ctx->submitAndWait([&](VkCommandBuffer cmd) {
+            pipe.bind(cmd);
+            VkDescriptorSet sets[2] = {s0.handle(), s1.handle()};
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), 0, 2,
+                                    sets, 0, nullptr);
+            layout.push(cmd, uint32_t(queries.size()));
+            vk::dispatch1D(cmd, uint32_t(queries.size()));
+            vk::hostReadBarrier(cmd);
+        });
+        return r.downloadVector<glm::vec4>(queries.size());
+    }
+    /** Every copy of level-`level` lattice sample `s` in the bricks of `pool` (radiance: the
+     *  radiance pool at slot + face; else the geometry pool). */
     std::vector<glm::vec4> copies(const std::vector<glm::vec4>& pool, glm::ivec3 s,
-                                  uint32_t level) const {
+                                  uint32_t level, bool radiance = true, uint32_t face = 0) const {
         std::vector<glm::vec4> out;
         const uint32_t depth = m_tree.leafDepth - level;
         const int cells = 1 << depth;
@@ -146,12 +203,12 @@ protected:
                 continue;
             const uint32_t node = m_tree.find(cell, depth);
             if (node == kNone) continue;
-            const uint32_t brick = m_tree.word(node, 1);
+            const uint32_t brick = m_tree.word(node, radiance ? 11 : 1);
             if (brick == kNone) continue;
-            const glm::uvec3 t = m_svo->brickTexel(brick, glm::uvec3(s - 2 * cell));
-            const auto& d = m_svo->info();
-            const size_t w = 3 * d.dims.z, h = 3 * d.capacity.w;
-            out.push_back(pool[t.x + w * (t.y + h * t.z)]);
+            const glm::uvec3 local(s - 2 * cell);
+            const glm::uvec3 t = radiance ? m_svo->radianceTexel(brick + face, local)
+                                          : m_svo->brickTexel(brick, local);
+            out.push_back(pool[m_svo->poolTexelIndex(t, radiance)]);
         }
         return out;
     }
@@ -172,10 +229,16 @@ protected:
 // Box faces through voxel centres 10 and 21: the voxelizer's shell is voxels 10..21 (known).
 constexpr float kLo = 10.5f, kHi = 21.5f;
 const glm::vec3 kAlbedo(0.5f, 0.25f, 1.0f);
-// Octree vs dense agreement (measured values in docs/vct_svo.md).
-constexpr double kAgreementRelMse = 0.03;     // measured 0.0114
-constexpr double kAgreementMeanAbs = 0.2;     // measured 0.132
-constexpr double kAgreementMeanRatio = 0.12;  // measured 0.926
+// Octree vs dense agreement (measured values in docs/vct_svo.md, with the cone march of the
+// radius level mapping and the surface lift; the earlier diameter mapping without lift measured
+// relMSE 0.0114, mean abs 0.132, ratio 0.926 isotropic).
+constexpr double kAgreementRelMse = 0.15;     // measured 0.068
+constexpr double kAgreementMeanAbs = 0.35;    // measured 0.167
+constexpr double kAgreementMeanRatio = 0.15;  // measured 0.912
+// Both anisotropic; the mean ratio bound is issue 9's "within 15 % of the dense variant".
+constexpr double kAnisoAgreementRelMse = 0.25;     // measured 0.120
+constexpr double kAnisoAgreementMeanAbs = 0.6;     // measured 0.336
+constexpr double kAnisoAgreementMeanRatio = 0.15;  // measured 0.884
 
 TEST_F(GpuVctSvoTest, LeafNodesAreTheOccupiedLeafCells) {
     build(boxScene(kAlbedo, kLo, kHi));
@@ -302,7 +365,7 @@ TEST_F(GpuVctSvoTest, GaussianOfAnImpulseHasTheTentWeights) {
     // three child layers along its normal: 1/2 of the weight (1/4, 1/2, 1/4 with the face at the
     // centre) -> alpha = 1/2.
     const std::vector<glm::vec4> geo = m_svo->readGeometryBricks();
-    for (const glm::vec4& g : copies(geo, glm::ivec3(8, 8, 5), 1))
+    for (const glm::vec4& g : copies(geo, glm::ivec3(8, 8, 5), 1, false))
         EXPECT_NEAR(g.a, 0.5f, 1e-3f);
 }
 
@@ -322,38 +385,7 @@ TEST_F(GpuVctSvoTest, ConeSamplerIsQuadrilinear) {
         glm::vec4(m_grid.voxelCenter({16, 16, 16}), 2.7f),  // coarse: some opacity
         glm::vec4(-1.0f, 5.0f, 5.0f, 0.0f),                 // outside the grid
     };
-    vk::Buffer q(*m_ctx, queries.size() * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                 vk::MemoryUsage::Upload, "test/queries");
-    q.uploadVector(queries);
-    vk::Buffer r(*m_ctx, queries.size() * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
-                 vk::MemoryUsage::Readback, "test/results");
-    std::vector<VkDescriptorSetLayoutBinding> b;
-    SparseVoxelOctree::addLayoutBindings(b, 0, VK_SHADER_STAGE_COMPUTE_BIT);
-    std::vector<vk::DescriptorBinding> bindings;
-    for (const auto& x : b)
-        bindings.push_back({x.binding, x.descriptorType, 1, x.stageFlags});
-    vk::DescriptorSetLayout l0(*m_ctx, bindings, "test/svo");
-    vk::DescriptorSetLayout l1(
-        *m_ctx,
-        {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT},
-         {1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT}},
-        "test/io");
-    vk::DescriptorSet s0(*m_ctx, l0), s1(*m_ctx, l1);
-    m_svo->writeDescriptors(s0, 0);
-    s1.writeBuffer(0, q);
-    s1.writeBuffer(1, r);
-    vk::PipelineLayout layout(*m_ctx, {l0.handle(), l1.handle()}, 4, VK_SHADER_STAGE_COMPUTE_BIT);
-    vk::ComputePipeline pipe(*m_ctx, "vct/svo_test_sample.comp", layout);
-    m_ctx->submitAndWait([&](VkCommandBuffer cmd) {
-        pipe.bind(cmd);
-        VkDescriptorSet sets[2] = {s0.handle(), s1.handle()};
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), 0, 2, sets, 0,
-                                nullptr);
-        layout.push(cmd, uint32_t(queries.size()));
-        vk::dispatch1D(cmd, uint32_t(queries.size()));
-        vk::hostReadBarrier(cmd);
-    });
-    const std::vector<glm::vec4> out = r.downloadVector<glm::vec4>(queries.size());
+    const std::vector<glm::vec4> out = sample(queries, glm::vec3(0.0f, 0.0f, 1.0f));
     const float tol = 0.01f;  // hardware filtering (8-bit sub-texel weights) and RGBA16F
     EXPECT_NEAR(out[0].r, v.r, tol * v.r);
     EXPECT_NEAR(out[0].a, 1.0f, tol);
@@ -370,7 +402,7 @@ TEST_F(GpuVctSvoTest, ConeSamplerIsQuadrilinear) {
 }
 
 /** The indirect layer of vct on the Cornell box spot variant at 64x64 with `storage`. */
-Image vctIndirect(vk::Context& ctx, const std::string& storage, uint32_t voxels,
+Image vctIndirect(vk::Context& ctx, const std::string& storage, uint32_t voxels, bool anisotropic,
                   std::vector<std::string>* notes = nullptr) {
     Scene scene = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", "spot");
     scene.settings.width = 64;
@@ -378,7 +410,7 @@ Image vctIndirect(vk::Context& ctx, const std::string& storage, uint32_t voxels,
     ParamSet params = TechniqueRegistry::instance().defaultParams("vct");
     params.set("storage", storage);
     params.set("voxel_resolution", std::to_string(voxels));
-    params.set("anisotropic", "false");  // the octree is isotropic: compare storage, not lobes
+    params.set("anisotropic", anisotropic ? "true" : "false");
     FrameHarness h(ctx, scene, "vct", params, defaultSharedParams());
     EXPECT_TRUE(h.support().supported) << h.support().reason;
     h.setup();
@@ -389,41 +421,413 @@ Image vctIndirect(vk::Context& ctx, const std::string& storage, uint32_t voxels,
     throw Error("no indirect layer");
 }
 
-// Same image within a documented tolerance (docs/vct_svo.md "Agreement with the dense variant"):
-// the two storages differ by design in their filtered levels (vertex-centred 3^3 Gaussian vs the
-// dense cell-centred pyramid), their sample positions at coarse levels and their edge handling.
-TEST_F(GpuVctSvoTest, OctreeAndDenseGiveTheSameIndirectLight) {
+struct Agreement {
+    double relMse = 0, relMeanAbs = 0, meanRatio = 0;
+};
+
+/** Octree vs dense indirect layers of vct on cornell_box.json#spot, 64x64, 64^3. */
+Agreement octreeVsDense(vk::Context& ctx, bool anisotropic) {
     std::vector<std::string> notes;
-    const Image dense = vctIndirect(*m_ctx, "dense", 64);
-    const Image octree = vctIndirect(*m_ctx, "octree", 64, &notes);
-    ASSERT_EQ(dense.values().size(), octree.values().size());
+    const Image dense = vctIndirect(ctx, "dense", 64, anisotropic);
+    const Image octree = vctIndirect(ctx, "octree", 64, anisotropic, &notes);
+    EXPECT_EQ(dense.values().size(), octree.values().size());
     const int c = dense.channels();
     double se = 0, ref2 = 0, absDiff = 0, refSum = 0, octSum = 0;
-    size_t n = 0;
-    for (size_t i = 0; i < dense.values().size(); ++i) {
+    for (size_t i = 0; i < std::min(dense.values().size(), octree.values().size()); ++i) {
         if (c == 4 && i % 4 == 3) continue;
         const double a = octree.values()[i], b = dense.values()[i];
-        ASSERT_TRUE(std::isfinite(a));
+        EXPECT_TRUE(std::isfinite(a));
         se += (a - b) * (a - b);
         ref2 += b * b;
         absDiff += std::abs(a - b);
         refSum += b;
         octSum += a;
-        ++n;
     }
-    ASSERT_GT(refSum, 0.0);
-    const double relMse = se / ref2;
-    const double relMeanAbs = absDiff / refSum;
-    const double meanRatio = octSum / refSum;
+    EXPECT_GT(refSum, 0.0);
+    Agreement r;
+    r.relMse = se / std::max(ref2, 1e-30);
+    r.relMeanAbs = absDiff / std::max(refSum, 1e-30);
+    r.meanRatio = octSum / std::max(refSum, 1e-30);
     std::printf(
-        "[svo] cornell#spot 64x64, 64^3: relMSE %.4f, mean |diff| / mean %.4f, mean "
+        "[svo] cornell#spot 64x64, 64^3, %s: relMSE %.4f, mean |diff| / mean %.4f, mean "
         "octree / dense %.4f\n",
-        relMse, relMeanAbs, meanRatio);
+        anisotropic ? "anisotropic" : "isotropic", r.relMse, r.relMeanAbs, r.meanRatio);
     for (const std::string& note : notes)
         std::printf("[svo]   note: %s\n", note.c_str());
-    EXPECT_LT(relMse, kAgreementRelMse);
-    EXPECT_LT(relMeanAbs, kAgreementMeanAbs);
-    EXPECT_NEAR(meanRatio, 1.0, kAgreementMeanRatio);
+    return r;
+}
+
+// Same image within a documented tolerance (docs/vct_svo.md "Agreement with the dense variant"):
+// the two storages differ by design in their filtered levels (vertex-centred 3^3 Gaussian vs the
+// dense cell-centred pyramid), their sample positions at coarse levels and their edge handling.
+TEST_F(GpuVctSvoTest, OctreeAndDenseGiveTheSameIndirectLight) {
+    const Agreement a = octreeVsDense(*m_ctx, false);
+    EXPECT_LT(a.relMse, kAgreementRelMse);
+    EXPECT_LT(a.relMeanAbs, kAgreementMeanAbs);
+    EXPECT_NEAR(a.meanRatio, 1.0, kAgreementMeanRatio);
+}
+
+// Both anisotropic (vct's default): the octree's directional bricks vs the dense directional
+// volumes (docs/vct_svo.md "Anisotropic").
+TEST_F(GpuVctSvoTest, AnisotropicOctreeAndDenseGiveTheSameIndirectLight) {
+    const Agreement a = octreeVsDense(*m_ctx, true);
+    EXPECT_LT(a.relMse, kAnisoAgreementRelMse);
+    EXPECT_LT(a.relMeanAbs, kAnisoAgreementMeanAbs);
+    EXPECT_NEAR(a.meanRatio, 1.0, kAnisoAgreementMeanRatio);
+}
+
+/** A one-voxel wall: the plane x = layer + 0.5 (voxel layer 16) across the whole 32^3 grid. */
+Scene wallScene(int layer = 16) {
+    Scene s;
+    s.name = "svo_wall";
+    s.sourcePath = "<test>";
+    Material m;
+    m.baseColorFactor = glm::vec4(kAlbedo, 1.0f);
+    s.materials.push_back(m);
+    const float x = float(layer) + 0.5f;
+    appendQuad(s, {x, 0, 0}, {x, 32, 0}, {x, 32, 32}, {x, 0, 32}, {1, 0, 0}, 0);
+    s.computeCaps();
+    return s;
+}
+
+// Crassin §9: a wall one voxel thick keeps opacity 1 along its normal at every level of the
+// anisotropic octree, while the isotropic Gaussian halves it per level (2^-l). Along the wall
+// (tangent) the directional value is the dense rule's 1/2 at the first level, then
+// t' = (1 - (1 - t)^2) / 2 (two half-covered layers composited, then half the tent): it stays
+// low. The wall's layer 16 = 2^4 lies on a parent's centre sample at every level (docs/vct_svo.md
+// "Anisotropic": a wall on an odd child sample keeps 1/2 at the next level).
+TEST_F(GpuVctSvoTest, AnisotropicWallIsOpaqueAlongItsNormal) {
+    for (int mode : {0, 1, 2}) {  // isotropic, pairs, slab
+        const bool aniso = mode != 0;
+        build(wallScene(), 32, aniso, 0, mode == 2 ? Filter::Slab : Filter::Pairs);
+        inject({{16, 16, 16}}, glm::vec3(kPi));
+        ASSERT_EQ(m_tree.leafDepth, 4u);
+        float tangent = 0.5f;
+        for (uint32_t level = 1; level <= m_tree.leafDepth; ++level) {
+            const glm::ivec3 s(16 >> level);  // the wall's centre sample at this level
+            SCOPED_TRACE("level " + std::to_string(level) + " mode " + std::to_string(mode));
+            if (!aniso) {
+                const std::vector<glm::vec4> c = copies(m_radiance, s, level);
+                ASSERT_FALSE(c.empty());
+                for (const glm::vec4& v : c)
+                    EXPECT_NEAR(v.a, std::ldexp(1.0f, -int(level)), 2e-3f);
+                continue;
+            }
+            for (uint32_t f = 0; f < 6; ++f) {
+                const std::vector<glm::vec4> c = copies(m_radiance, s, level, true, f);
+                ASSERT_FALSE(c.empty());
+                for (const glm::vec4& v : c) {
+                    if (f < 2)
+                        EXPECT_NEAR(v.a, 1.0f, 2e-3f) << "face " << f;
+                    else
+                        EXPECT_NEAR(v.a, tangent, 3e-3f) << "face " << f;
+                }
+            }
+            // Off the wall (one level-l sample away along x): nothing along the normal either.
+            for (uint32_t f = 0; f < 2; ++f)
+                for (const glm::vec4& v :
+                     copies(m_radiance, s + glm::ivec3(1, 0, 0), level, true, f))
+                    EXPECT_NEAR(v.a, 0.0f, 1e-3f);
+            tangent = 0.5f * (1.0f - (1.0f - tangent) * (1.0f - tangent));
+        }
+        // The sampler: dir^2-weighted faces (normal: 1, tangent: <= 1/2, isotropic: 2^-l).
+        const glm::vec3 at = m_grid.voxelCenter({16, 16, 16});
+        std::vector<glm::vec4> q;
+        for (float lod : {1.0f, 2.0f, 3.0f, 0.5f, 2.5f})
+            q.push_back(glm::vec4(at, lod));
+        const std::vector<glm::vec4> nx = sample(q, glm::vec3(-1, 0, 0));
+        const std::vector<glm::vec4> px = sample(q, glm::vec3(1, 0, 0));
+        const std::vector<glm::vec4> py = sample(q, glm::vec3(0, 1, 0));
+        const std::vector<glm::vec4> diag = sample(q, glm::normalize(glm::vec3(1, 1, 0)));
+        // Tangent opacity per level: the leaves are isotropic (1), then 1/2, 3/8, ...
+        std::vector<float> tangentAt = {1.0f, 0.5f};
+        while (tangentAt.size() < 5) {
+            const float t = tangentAt.back();
+            tangentAt.push_back(0.5f * (1.0f - (1.0f - t) * (1.0f - t)));
+        }
+        for (size_t i = 0; i < q.size(); ++i) {
+            const float lod = q[i].w;
+            const int l0 = int(std::floor(lod));
+            const float f = lod - float(l0);
+            auto lerp = [&](float a0, float a1) { return (1.0f - f) * a0 + f * a1; };
+            SCOPED_TRACE("lod " + std::to_string(lod) + " mode " + std::to_string(mode));
+            if (aniso) {
+                EXPECT_NEAR(nx[i].a, 1.0f, 0.01f);
+                EXPECT_NEAR(px[i].a, 1.0f, 0.01f);
+                EXPECT_NEAR(py[i].a, lerp(tangentAt[l0], tangentAt[l0 + 1]), 0.01f);
+                if (lod >= 1.0f) {
+                    EXPECT_LE(py[i].a, 0.5f + 0.01f);
+                }
+                EXPECT_NEAR(diag[i].a, 0.5f * (px[i].a + py[i].a), 0.01f);
+            } else {
+                const float expected = lerp(std::exp2(-float(l0)), std::exp2(-float(l0 + 1)));
+                EXPECT_NEAR(nx[i].a, expected, 0.01f);
+                EXPECT_NEAR(py[i].a, expected, 0.01f);
+            }
+        }
+    }
+}
+
+// A wall on an odd leaf sample (voxel layer 17) falls between two level-1 samples. The pair
+// filter gives each 1/2 along the normal (one of its two pairs holds the wall); the slab filter
+// integrates the wall's half depth into both: 1 (docs/vct_svo.md "Anisotropic").
+TEST_F(GpuVctSvoTest, OddWallKeepsHalfWithPairsAndAllWithSlabs) {
+    for (Filter filter : {Filter::Pairs, Filter::Slab}) {
+        SCOPED_TRACE(filter == Filter::Slab ? "slab" : "pairs");
+        build(wallScene(17), 32, true, 0, filter);
+        inject({{17, 16, 16}}, glm::vec3(kPi));
+        const float expected = filter == Filter::Slab ? 1.0f : 0.5f;
+        for (int x : {8, 9})
+            for (uint32_t f = 0; f < 2; ++f)
+                for (const glm::vec4& v : copies(m_radiance, {x, 8, 8}, 1, true, f))
+                    EXPECT_NEAR(v.a, expected, 2e-3f) << "x " << x << " face " << f;
+        for (uint32_t f = 0; f < 2; ++f)
+            for (const glm::vec4& v : copies(m_radiance, {7, 8, 8}, 1, true, f))
+                EXPECT_NEAR(v.a, 0.0f, 1e-3f);
+    }
+}
+
+/** CPU directional filter on the global level lattice (no partial sums, no transfer). */
+glm::vec4 cpuComposite(glm::vec4 front, glm::vec4 back) {
+    return front + (1.0f - glm::clamp(front.a, 0.0f, 1.0f)) * back;
+}
+glm::vec4 cpuHalfSlab(glm::vec4 v) {
+    const float a = glm::clamp(v.a, 0.0f, 1.0f);
+    if (!(a > 1e-6f)) return 0.5f * v;
+    const float h = a >= 1.0f ? 1.0f : 1.0f - std::sqrt(1.0f - a);
+    return glm::vec4(glm::vec3(v) * (h / a), h);
+}
+
+// The GPU's directional bricks (per-parent partial sums + add/copy transfer, neighbour reads for
+// the slab filter) equal a direct evaluation of the filter on the global lattice of the level
+// below, for every sample, face and copy of levels 1 and 2 (box shell on even and odd layers).
+TEST_F(GpuVctSvoTest, DirectionalBricksMatchACpuFilter) {
+    for (Filter filter : {Filter::Pairs, Filter::Slab}) {
+        SCOPED_TRACE(filter == Filter::Slab ? "slab" : "pairs");
+        build(boxScene(kAlbedo, kLo, kHi), 32, true, 0, filter);
+        std::vector<glm::ivec3> photons;
+        for (int a = 10; a <= 21; ++a)
+            for (int b = 10; b <= 21; b += 1) {
+                photons.push_back({a, b, 10});     // z = 10 face (even layer)
+                photons.push_back({21, a, b});     // x = 21 face (odd layer)
+                if ((a + b) % 3 == 0) photons.push_back({a, 21, b});
+            }
+        inject(photons, glm::vec3(8.0f * kPi));
+        size_t checked = 0, nonzero = 0;
+        for (uint32_t level = 1; level <= 2; ++level) {
+            const int below = 32 >> (level - 1);  // samples 0 .. below at the level below
+            for (uint32_t f = 0; f < 6; ++f) {
+                const int axis = int(f / 2);
+                const bool towardPositive = (f & 1) != 0;
+                // The level below (leaves: isotropic; else face f), one copy per sample.
+                auto at = [&](glm::ivec3 c) {
+                    if (glm::any(glm::lessThan(c, glm::ivec3(0))) ||
+                        glm::any(glm::greaterThan(c, glm::ivec3(below))))
+                        return glm::vec4(0.0f);
+                    const std::vector<glm::vec4> v =
+                        copies(m_radiance, c, level - 1, true, level == 1 ? 0 : f);
+                    return v.empty() ? glm::vec4(0.0f) : glm::max(v[0], glm::vec4(0.0f));
+                };
+                const int n = below / 2;
+                for (int z = 0; z <= n; ++z)
+                    for (int y = 0; y <= n; ++y)
+                        for (int x = 0; x <= n; ++x) {
+                            const glm::ivec3 p(x, y, z);
+                            glm::vec4 expected(0.0f);
+                            const int au = (axis + 1) % 3, av = (axis + 2) % 3;
+                            for (int du = -1; du <= 1; ++du)
+                                for (int dv = -1; dv <= 1; ++dv) {
+                                    const float w = (du == 0 ? 0.5f : 0.25f) *
+                                                    (dv == 0 ? 0.5f : 0.25f);
+                                    glm::ivec3 c = 2 * p;
+                                    c[au] += du;
+                                    c[av] += dv;
+                                    glm::ivec3 lo = c, hi = c;
+                                    lo[axis] -= 1;
+                                    hi[axis] += 1;
+                                    glm::vec4 l = at(lo), m = at(c), h = at(hi);
+                                    if (!towardPositive) std::swap(l, h);
+                                    if (filter == Filter::Slab)
+                                        expected += w * cpuComposite(
+                                                            cpuHalfSlab(l),
+                                                            cpuComposite(m, cpuHalfSlab(h)));
+                                    else
+                                        expected += 0.5f * w *
+                                                    (cpuComposite(l, m) + cpuComposite(m, h));
+                                }
+                            const std::vector<glm::vec4> got =
+                                copies(m_radiance, p, level, true, f);
+                            if (got.empty()) {
+                                EXPECT_LT(glm::length(expected), 1e-4f) << p.x << p.y << p.z;
+                                continue;
+                            }
+                            nonzero += expected.a > 0.0f;
+                            for (const glm::vec4& g : got) {
+                                const float tol = 4e-3f * (1.0f + glm::length(expected));
+                                EXPECT_NEAR(glm::length(g - expected), 0.0f, tol)
+                                    << "level " << level << " face " << f << " sample " << p.x
+                                    << "," << p.y << "," << p.z << " got " << g.r << " " << g.a
+                                    << " expected " << expected.r << " " << expected.a;
+                                ++checked;
+                            }
+                        }
+            }
+        }
+        std::printf("[svo] %s: %zu directional samples checked (%zu with opacity)\n",
+                    filter == Filter::Slab ? "slab" : "pairs", checked, nonzero);
+        EXPECT_GT(nonzero, 500u);
+    }
+}
+
+// Face convention (as the dense volumes, docs/voxel_cone_tracing.md): face +X holds what rays
+// travelling toward +x see, so they meet the smaller-x layer first. A red layer (voxels x = 16)
+// in front of a green one (x = 17): +X sees red only, -X sees green, at every level.
+TEST_F(GpuVctSvoTest, AnisotropicFacesSeeTheNearLayerFirst) {
+    Scene s;
+    s.name = "svo_layers";
+    s.sourcePath = "<test>";
+    for (glm::vec3 albedo : {glm::vec3(1, 0, 0), glm::vec3(0, 1, 0)}) {
+        Material m;
+        m.baseColorFactor = glm::vec4(albedo, 1.0f);
+        s.materials.push_back(m);
+    }
+    for (uint32_t k = 0; k < 2; ++k) {
+        const float x = 16.5f + float(k);
+        appendQuad(s, {x, 0, 0}, {x, 32, 0}, {x, 32, 32}, {x, 0, 32}, {1, 0, 0}, k);
+    }
+    s.computeCaps();
+    build(s, 32, true);
+    std::vector<glm::ivec3> photons;
+    for (int x = 16; x <= 17; ++x)
+        for (int z = 8; z <= 24; ++z)  // the level-3 tent around voxel 16 reaches 9 .. 23
+            for (int y = 8; y <= 24; ++y)
+                photons.push_back({x, y, z});
+    inject(photons, glm::vec3(kPi));
+    for (uint32_t level = 1; level <= 3; ++level) {
+        SCOPED_TRACE("level " + std::to_string(level));
+        const glm::ivec3 at(16 >> level);
+        const std::vector<glm::vec4> towardPosX = copies(m_radiance, at, level, true, 1);
+        const std::vector<glm::vec4> towardNegX = copies(m_radiance, at, level, true, 0);
+        ASSERT_FALSE(towardPosX.empty());
+        for (const glm::vec4& v : towardPosX) {
+            EXPECT_NEAR(v.a, 1.0f, 2e-3f);
+            EXPECT_GT(v.r, 0.5f);
+            EXPECT_LT(v.g, 1e-3f * v.r);
+        }
+        for (const glm::vec4& v : towardNegX) {
+            EXPECT_NEAR(v.a, 1.0f, 2e-3f);
+            EXPECT_GT(v.g, 0.2f * v.r);
+        }
+    }
+}
+
+// The radiance pool of the anisotropic octree holds one brick per leaf and six per inner node;
+// reported next to the isotropic one (docs/vct_svo.md "Memory"; Crassin §9 quotes ~1.5x).
+TEST_F(GpuVctSvoTest, AnisotropicMemoryIsAboutOneAndAHalfIsotropic) {
+    Scene scene = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", "spot");
+    const VoxelGrid grid(scene.caps.bounds, 64);
+    std::map<bool, SparseVoxelOctree::Memory> used, cap;
+    for (bool aniso : {false, true}) {
+        buildInGrid(scene, grid, aniso);
+        used[aniso] = m_svo->usedMemory();
+        cap[aniso] = m_svo->memory();
+        uint32_t leaves = 0;
+        for (uint32_t i = 0; i < used[aniso].nodeCount; ++i)
+            leaves += m_tree.word(i, 10) == m_tree.leafDepth && m_tree.word(i, 1) != kNone;
+        const uint32_t inner = used[aniso].brickCount - leaves;
+        EXPECT_EQ(used[aniso].radianceCount, aniso ? leaves + 6 * inner : leaves + inner);
+        EXPECT_LE(used[aniso].radianceCount, cap[aniso].radianceCount);
+        std::printf(
+            "[svo] cornell 64^3 %s: nodes %u, bricks %u (%u leaves), radiance bricks %u; used "
+            "%.2f MiB (nodes %.2f, geometry %.2f, radiance %.2f), allocated %.2f MiB\n",
+            aniso ? "anisotropic" : "isotropic", used[aniso].nodeCount, used[aniso].brickCount,
+            leaves, used[aniso].radianceCount, used[aniso].total() / 1048576.0,
+            used[aniso].nodeBytes / 1048576.0, used[aniso].geometryBytes / 1048576.0,
+            used[aniso].radianceBytes / 1048576.0, cap[aniso].total() / 1048576.0);
+    }
+    EXPECT_EQ(used[false].brickCount, used[true].brickCount);
+    EXPECT_EQ(used[false].nodeCount, used[true].nodeCount);
+    const double ratio = double(used[true].total()) / double(used[false].total());
+    const double radianceRatio =
+        double(used[true].radianceBytes) / double(used[false].radianceBytes);
+    std::printf("[svo] anisotropic / isotropic octree: total %.3f, radiance pool %.3f\n", ratio,
+                radianceRatio);
+    EXPECT_GT(ratio, 1.3);
+    EXPECT_LT(ratio, 1.8);
+    EXPECT_NEAR(double(cap[true].total()) / double(cap[false].total()), ratio, 0.1);
+}
+
+// Every octree dispatch as a 2D grid (at most 5 groups per row: 64^3 leaf occupancy, filters and
+// transfers all split, with surplus threads) builds the same octree as 1D dispatches: the shaders
+// rebuild the thread index from both dimensions.
+TEST_F(GpuVctSvoTest, SplitDispatchesBuildTheSameOctree) {
+    const std::vector<glm::ivec3> photons = {{12, 14, 10}, {16, 19, 10}, {10, 13, 15}};
+    std::map<uint32_t, std::vector<glm::vec4>> radiance, geometry;
+    std::map<uint32_t, Tree> trees;
+    for (uint32_t maxGroups : {0u, 5u}) {
+        build(boxScene(kAlbedo, kLo, kHi), 32, true, maxGroups, Filter::Slab);
+        inject(photons, glm::vec3(64.0f * kPi));
+        radiance[maxGroups] = m_radiance;
+        geometry[maxGroups] = m_svo->readGeometryBricks();
+        trees[maxGroups] = m_tree;
+    }
+    // Compare by cell (allocation order may differ): every sample of every level and face.
+    size_t compared = 0, lit = 0;
+    for (uint32_t level = 0; level <= m_tree.leafDepth; ++level) {
+        const int samples = 2 * (1 << (m_tree.leafDepth - level)) + 1;
+        for (int z = 0; z < samples; ++z)
+            for (int y = 0; y < samples; ++y)
+                for (int x = 0; x < samples; ++x) {
+                    for (uint32_t f = 0; f < (level == 0 ? 1u : 6u); ++f) {
+                        m_tree = trees[0];
+                        const auto a = copies(radiance[0], {x, y, z}, level, true, f);
+                        const auto ga = copies(geometry[0], {x, y, z}, level, false);
+                        m_tree = trees[5];
+                        const auto b = copies(radiance[5], {x, y, z}, level, true, f);
+                        const auto gb = copies(geometry[5], {x, y, z}, level, false);
+                        ASSERT_EQ(a.size(), b.size());
+                        ASSERT_EQ(ga.size(), gb.size());
+                        for (size_t i = 0; i < a.size(); ++i) {
+                            EXPECT_NEAR(glm::length(a[i] - b[i]), 0.0f,
+                                        1e-3f * (1.0f + glm::length(a[i])));
+                            EXPECT_NEAR(glm::length(ga[i] - gb[i]), 0.0f, 1e-3f);
+                            lit += a[i].r > 0.0f;
+                        }
+                        compared += a.size();
+                    }
+                }
+    }
+    std::printf("[svo] split dispatches: %zu brick samples compared, %zu lit\n", compared, lit);
+    EXPECT_GT(compared, 1000u);
+    EXPECT_GT(lit, 10u);
+}
+
+// The group counts of every octree dispatch stay within maxComputeWorkGroupCount; Sponza at
+// 256^3 filtered 104,875 groups in x in one dispatch (issue 9, item 6).
+TEST(CpuVctSvoDispatch, GroupsStayWithinTheDeviceLimit) {
+    const uint32_t maxX = 65535, maxY = 65535, group = SparseVoxelOctree::kGroupSize;
+    for (uint64_t threads : {uint64_t(0), uint64_t(1), uint64_t(64), uint64_t(65),
+                             uint64_t(65535) * 64, uint64_t(65535) * 64 + 1,
+                             uint64_t(104875) * 64, uint64_t(104875) * 64 - 5,
+                             uint64_t(256) * 256 * 256, uint64_t(1) << 32}) {
+        const glm::uvec3 g = SparseVoxelOctree::dispatchGroups(threads, group, maxX, maxY);
+        SCOPED_TRACE(threads);
+        EXPECT_LE(g.x, maxX);
+        EXPECT_LE(g.y, maxY);
+        EXPECT_EQ(g.z, threads == 0 ? 0u : 1u);
+        const uint64_t launched = uint64_t(g.x) * g.y * g.z * group;
+        EXPECT_GE(launched, threads);
+        // Surplus below one row of groups (the shaders' bounds checks drop it).
+        EXPECT_LT(launched, threads + uint64_t(std::max(g.x, 1u)) * group);
+        if (threads > 0 && threads <= uint64_t(maxX) * group) {
+            EXPECT_EQ(g.y, 1u);
+        }
+    }
+    const glm::uvec3 sponza = SparseVoxelOctree::dispatchGroups(104875ull * 64, group, maxX, maxY);
+    EXPECT_EQ(sponza, glm::uvec3(65535, 2, 1));
+    EXPECT_THROW(SparseVoxelOctree::dispatchGroups(uint64_t(maxX) * maxY * group + 1, group, maxX,
+                                                   maxY),
+                 Error);
 }
 
 }  // namespace

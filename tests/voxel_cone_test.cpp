@@ -62,16 +62,34 @@ TEST(CpuConeSet, SixSixtyDegreeConesTrueTiltAndCosineWeights) {
     expectValidSet(set, 6);
     EXPECT_NEAR(set.apertureRad, glm::radians(60.0f), 1e-6f);
     for (size_t i = 1; i < 6; ++i) {
-        // Default tilt 60 deg (notes 003 §8), 72 deg azimuth steps.
+        // Default tilt 60 deg (notes 003 §8), 72 deg azimuth steps from 45/5 = 9 deg.
         EXPECT_NEAR(std::acos(set.cones[i].direction.z), glm::radians(60.0f), 1e-5f);
         const float phi = std::atan2(set.cones[i].direction.y, set.cones[i].direction.x);
-        const float expected = glm::radians(72.0f * float(i - 1));
+        const float expected = glm::radians(9.0f + 72.0f * float(i - 1));
         EXPECT_NEAR(std::cos(phi - expected), 1.0f, 1e-5f);
     }
     // Unclipped cones: weight ~ pi sin^2(h) cos(tilt), so the side cones get half the normal
     // cone's weight: pi / 3.5 and pi / 7.
     EXPECT_NEAR(set.cones[0].weight, kPi / 3.5f, 1e-4f);
     EXPECT_NEAR(set.cones[1].weight, kPi / 7.0f, 1e-4f);
+}
+
+TEST(CpuConeSet, RingConesNeverAimAlongTangentAxes) {
+    // The tangent frame follows the world axes, so an axis-aligned ring aims its cones straight
+    // at the walls of an axis-aligned room (issue 9: the 3-cone set's old orientation).
+    for (uint32_t count = 2; count <= kMaxCones; ++count) {
+        const ConeSet set = makeDiffuseConeSet(count, 60.0f);
+        const float ring = float(count - 1);
+        // Closest approach of a ring of m equal steps offset by 45/m deg to a multiple of 90.
+        const float margin = std::min(2.0f, 22.0f / ring);
+        for (size_t i = 1; i < set.cones.size(); ++i) {
+            const glm::vec3 d = set.cones[i].direction;
+            const float phi = glm::degrees(std::atan2(d.y, d.x));
+            const float toAxis = std::abs(std::remainder(phi, 90.0f));
+            EXPECT_GT(toAxis, margin) << count << " cones, cone " << i << " at " << phi << " deg";
+        }
+    }
+    EXPECT_NEAR(glm::degrees(ringAzimuthOffset(2)), 22.5f, 1e-4f);  // 3 cones: 22.5 and 202.5
 }
 
 TEST(CpuConeSet, CosineWeightedSolidAngleMatchesClosedForm) {
@@ -422,13 +440,16 @@ struct ConePush {
 
 class ConeRunner {
 public:
+    // After VoxelRadiance's bindings 0..7 (shaders/common/test_voxel_cone.comp).
+    static constexpr uint32_t kQueryBinding = 9, kResultBinding = 10;
+
     ConeRunner(vk::Context& ctx, VoxelRadiance& rad) : m_ctx(ctx), m_rad(rad) {
         std::vector<vk::DescriptorBinding> bindings;
         VoxelRadiance::addLayoutBindings(bindings, 0, VK_SHADER_STAGE_COMPUTE_BIT);
-        bindings.push_back(
-            {7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, false});
-        bindings.push_back(
-            {8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, false});
+        bindings.push_back({kQueryBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+                            VK_SHADER_STAGE_COMPUTE_BIT, false});
+        bindings.push_back({kResultBinding, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+                            VK_SHADER_STAGE_COMPUTE_BIT, false});
         m_layout = vk::DescriptorSetLayout(ctx, bindings, "test/cone");
         m_pipelineLayout = vk::PipelineLayout(ctx, {m_layout.handle()}, sizeof(ConePush),
                                               VK_SHADER_STAGE_COMPUTE_BIT);
@@ -450,8 +471,8 @@ public:
                        vk::MemoryUsage::Readback, "test/results");
         vk::DescriptorSet set(m_ctx, m_layout, 0, "test/cone");
         m_rad.writeDescriptors(set, 0);
-        set.writeBuffer(7, in);
-        set.writeBuffer(8, out);
+        set.writeBuffer(kQueryBinding, in);
+        set.writeBuffer(kResultBinding, out);
         ConePush push{m_rad.grid().gpu(), m_rad.options().anisotropic ? 1u : 0u,
                       uint32_t(queries.size())};
         m_ctx.submitAndWait([&](VkCommandBuffer cmd) {

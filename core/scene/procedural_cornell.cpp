@@ -117,8 +117,9 @@ void validate(const CornellBoxParams& p) {
     if (!(p.albedoScale >= 0.0f) || !std::isfinite(p.albedoScale)) {
         invalid("albedo_scale must be >= 0 (got " + std::to_string(p.albedoScale) + ")");
     }
-    if (!finiteNonNegative(p.white) || !finiteNonNegative(p.red) || !finiteNonNegative(p.green)) {
-        invalid("white, red and green must be finite and >= 0");
+    if (!finiteNonNegative(p.white) || !finiteNonNegative(p.red) || !finiteNonNegative(p.green) ||
+        (p.floor && !finiteNonNegative(*p.floor))) {
+        invalid("white, red, green and floor must be finite and >= 0");
     }
     if (!finiteNonNegative(p.lightRadiance)) invalid("light_radiance must be finite and >= 0");
     const glm::vec2 half = 0.5f * (kLightHi - kLightLo) * kMm * p.lightSize;
@@ -157,7 +158,7 @@ Scene makeCornellBox(const CornellBoxParams& p) {
 
     // Walls: floor and ceiling span the full outer footprint, the sides cover the corners.
     addWall(scene, {-t, 0.0f, zFront}, (size.x + 2 * t) * X, depth * Z, Y, t, noHole,
-            addMaterial(scene, "floor", albedo(p.white)));
+            addMaterial(scene, "floor", albedo(p.floor.value_or(p.white))));
     addWall(scene, {-t, size.y, zFront}, (size.x + 2 * t) * X, depth * Z, -Y, t, noHole,
             addMaterial(scene, "ceiling", albedo(p.white)));
     addWall(scene, {0.0f, 0.0f, size.z}, size.x * X, size.y * Y, -Z, t, p.opening,
@@ -202,7 +203,7 @@ Scene makeCornellBox(const CornellBoxParams& p) {
 
 CornellBoxParams cornellBoxParamsFromJson(const JsonNode& node) {
     node.expectKeys({"generator", "wall_thickness", "albedo_scale", "white", "red", "green",
-                     "light_size", "light_radiance", "light_offset", "light", "blocks",
+                     "floor", "light_size", "light_radiance", "light_offset", "light", "blocks",
                      "front_wall", "opening"});
     CornellBoxParams p;
     if (node.has("wall_thickness")) p.wallThickness = float(node["wall_thickness"].numberIn(0, 1));
@@ -210,6 +211,7 @@ CornellBoxParams cornellBoxParamsFromJson(const JsonNode& node) {
     if (node.has("white")) p.white = node["white"].color(1.0);
     if (node.has("red")) p.red = node["red"].color(1.0);
     if (node.has("green")) p.green = node["green"].color(1.0);
+    if (node.has("floor")) p.floor = node["floor"].color(1.0);
     if (node.has("light_size")) p.lightSize = float(node["light_size"].numberIn(1e-3, 4.0));
     if (node.has("light_radiance")) p.lightRadiance = node["light_radiance"].color();
     if (node.has("light_offset")) p.lightOffset = float(node["light_offset"].numberIn(0, 0.099));

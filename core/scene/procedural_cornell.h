@@ -13,6 +13,7 @@
  * | albedo_scale     | albedoScale    | 1                    | scales every wall/block albedo   |
  * |                  |                |                      | (result clamped to [0, 1])       |
  * | white/red/green  | white/red/green| measured colours     | albedo overrides (linear RGB)    |
+ * | floor            | floor          | = white              | floor albedo override            |
  * | light_size       | lightSize      | 1                    | light quad scale about its centre|
  * | light_radiance   | lightRadiance  | [17, 12, 4]          | W/(m^2 sr)                       |
  * | light_offset     | lightOffset    | 0.0005               | m the light hangs below ceiling  |
@@ -42,6 +43,7 @@ struct CornellBoxParams {
     glm::vec3 white{0.725f, 0.71f, 0.68f};
     glm::vec3 red{0.63f, 0.065f, 0.05f};
     glm::vec3 green{0.14f, 0.45f, 0.091f};
+    std::optional<glm::vec3> floor;  // the floor's albedo; white when unset
     float lightSize = 1.0f;
     glm::vec3 lightRadiance{17.0f, 12.0f, 4.0f};
     float lightOffset = 0.0005f;

@@ -31,6 +31,12 @@ float coneCosineWeightedSolidAngle(float halfAngle, float tilt) {
     return float(sum * da * dp);
 }
 
+float ringAzimuthOffset(uint32_t ringCount) {
+    // (pi/4 + 2 pi i) / m = k pi/2 has no integer solution (1 + 8i = 2km: odd = even), so no
+    // ring cone of a ring of m lies on a tangent axis, for every m.
+    return ringCount == 0 ? 0.0f : 0.25f * glm::pi<float>() / float(ringCount);
+}
+
 ConeSet makeDiffuseConeSet(uint32_t count, float apertureDeg, float tiltDeg) {
     if (count < 1 || count > kMaxCones) {
         throw Error("cone set: count = " + std::to_string(count) + " outside [1, " +
@@ -47,11 +53,13 @@ ConeSet makeDiffuseConeSet(uint32_t count, float apertureDeg, float tiltDeg) {
     ConeSet set;
     set.apertureRad = glm::radians(apertureDeg);
     const float half = 0.5f * set.apertureRad;
-    // The normal cone, then a ring at equal azimuth steps (notes 003 §8 choice: true tilt).
+    // The normal cone, then a ring at equal azimuth steps (notes 003 §8 choice: true tilt),
+    // rotated by ringAzimuthOffset so that no ring cone lies along a tangent axis.
     set.cones.push_back({glm::vec3(0.0f, 0.0f, 1.0f), coneCosineWeightedSolidAngle(half, 0.0f)});
     const float ringWeight = coneCosineWeightedSolidAngle(half, tilt);
+    const float offset = ringAzimuthOffset(count - 1);
     for (uint32_t i = 1; i < count; ++i) {
-        const float phi = 2.0f * glm::pi<float>() * float(i - 1) / float(count - 1);
+        const float phi = offset + 2.0f * glm::pi<float>() * float(i - 1) / float(count - 1);
         glm::vec3 d(std::sin(tilt) * std::cos(phi), std::sin(tilt) * std::sin(phi), std::cos(tilt));
         set.cones.push_back({glm::normalize(d), ringWeight});
     }

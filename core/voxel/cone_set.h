@@ -23,7 +23,14 @@ struct ConeSet {
     float apertureRad = 0.0f;  // full apex angle
 };
 
-/** One cone along the normal, then count-1 tilted by tiltDeg at equal azimuth steps; weights
+/** Azimuth (radians) of the first ring cone for a ring of `ringCount` cones: (pi/4) / ringCount.
+ *  No ring cone then lies along the tangent frame's axes (the frame follows the world axes, so
+ *  an axis-aligned ring would aim every ring cone of an axis-aligned room at its walls; issue 9).
+ */
+float ringAzimuthOffset(uint32_t ringCount);
+
+/** One cone along the normal, then count-1 tilted by tiltDeg at equal azimuth steps (rotated by
+ *  ringAzimuthOffset); weights
  *  ~ cosine-weighted solid angle of each cone, normalised so sum w = pi. count in [1,16], aperture
  *  in (0,180) deg, tilt in [0,90) deg; tiltDeg < 0 = default (60 deg, notes 003 §8). Throws
  *  gilab::Error naming the argument. */

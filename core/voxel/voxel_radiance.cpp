@@ -32,11 +32,12 @@ uint32_t log2u(uint32_t n) {
 }
 
 vk::Image makeVolume(vk::Context& ctx, uint32_t n, VkFormat format, uint32_t mips,
-                     const std::string& name) {
+                     const std::string& name, uint32_t slabs = 1) {
     vk::ImageDesc desc;
     desc.kind = vk::ImageKind::Image3D;
     desc.format = format;
-    desc.width = desc.height = desc.depth = n;
+    desc.width = desc.height = n;
+    desc.depth = n * slabs;
     desc.mipLevels = mips;
     desc.usage =
         VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
@@ -60,12 +61,8 @@ VoxelRadiance::VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid,
     const std::string tag = memoryTag.empty() ? std::string("radiance") : memoryTag;
     const uint32_t filteredLevels = log2u(n);  // (N/2)^3 ... 1^3
     m_base = makeVolume(ctx, n, m_format, 1, tag + "/base");
-    const uint32_t volumeCount = options.anisotropic ? kFaceCount : 1;
-    for (uint32_t f = 0; f < volumeCount; ++f) {
-        const std::string name =
-            options.anisotropic ? tag + "/face" + kFaceNames[f] : tag + "/isotropic";
-        m_volumes.push_back(makeVolume(ctx, n / 2, m_format, filteredLevels, name));
-    }
+    m_filtered = makeVolume(ctx, n / 2, m_format, filteredLevels,
+                            tag + (options.anisotropic ? "/faces" : "/isotropic"), slabCount());
 
     vk::SamplerDesc sd;
     sd.filter = VK_FILTER_LINEAR;
@@ -75,12 +72,19 @@ VoxelRadiance::VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid,
     sd.name = tag + "/sampler";
     m_sampler = vk::Sampler(ctx, sd);
 
-    // Filter passes: binding 0 = sources, binding 1 = destinations (6 each when anisotropic).
+    m_noNormals = makeVolume(ctx, 1, m_format, 1, tag + "/no_normals");
+    m_normalView = m_noNormals.view();
+
+    // Filter passes: binding 0 = source level, binding 1 = destination level (atlas mips; the
+    // base is the source of the first), binding 2 = surface normals (facing weights of the first
+    // directional level).
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-    m_setLayout = vk::DescriptorSetLayout(ctx,
-                                          {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, volumeCount, cs},
-                                           {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, volumeCount, cs}},
-                                          tag + "/filter");
+    m_setLayout =
+        vk::DescriptorSetLayout(ctx,
+                                {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                 {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs}},
+                                tag + "/filter");
     m_pipelineLayout =
         vk::PipelineLayout(ctx, {m_setLayout.handle()}, sizeof(FilterPush), cs, tag + "/filter");
     const std::string suffix = options.fullPrecision ? "_f32.comp" : ".comp";
@@ -94,11 +98,9 @@ VoxelRadiance::VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid,
     }
     for (uint32_t level = 0; level < filteredLevels; ++level) {
         vk::DescriptorSet set(ctx, m_setLayout, 0, tag + "/filter.level" + std::to_string(level));
-        for (uint32_t f = 0; f < volumeCount; ++f) {
-            VkImageView src = level == 0 ? m_base.view() : m_volumes[f].mipView(level - 1);
-            set.writeStorageImage(0, src, f);
-            set.writeStorageImage(1, m_volumes[f].mipView(level), f);
-        }
+        set.writeStorageImage(0, level == 0 ? m_base.view() : m_filtered.mipView(level - 1));
+        set.writeStorageImage(1, m_filtered.mipView(level));
+        set.writeSampledImage(2, m_normalView, m_sampler.handle(), m_normalLayout);
         m_sets.push_back(std::move(set));
     }
 
@@ -106,9 +108,20 @@ VoxelRadiance::VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid,
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
         const VkClearColorValue zero{};
         m_base.clearColor(cmd, zero);
-        for (vk::Image& v : m_volumes)
-            v.clearColor(cmd, zero);
+        m_noNormals.clearColor(cmd, zero);
+        m_filtered.clearColor(cmd, zero);
     });
+}
+
+void VoxelRadiance::setSurfaceNormals(const vk::Image& normals) {
+    if (normals.width() != m_grid.resolution() || normals.desc().depth != m_grid.resolution()) {
+        throw Error("VoxelRadiance: surface normals are " + std::to_string(normals.width()) +
+                    "^3, the grid is " + std::to_string(m_grid.resolution()) + "^3");
+    }
+    m_normalView = normals.view();
+    m_normalLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    for (vk::DescriptorSet& set : m_sets)
+        set.writeSampledImage(2, m_normalView, m_sampler.handle(), m_normalLayout);
 }
 
 void VoxelRadiance::clearBase(VkCommandBuffer cmd) {
@@ -175,15 +188,8 @@ void VoxelRadiance::addLayoutBindings(std::vector<vk::DescriptorBinding>& out, u
 void VoxelRadiance::writeDescriptors(vk::DescriptorSet& set, uint32_t first) const {
     const VkImageLayout general = VK_IMAGE_LAYOUT_GENERAL;
     set.writeSampledImage(first, m_base.view(), m_sampler.handle(), general);
-    for (uint32_t f = 0; f < kFaceCount; ++f) {
-        const vk::Image& v = m_volumes[m_options.anisotropic ? f : 0];
-        set.writeSampledImage(first + 1 + f, v.view(), m_sampler.handle(), general);
-    }
-}
-
-vk::Image& VoxelRadiance::face(uint32_t f) {
-    if (f >= kFaceCount) throw Error("VoxelRadiance: face = " + std::to_string(f) + " > 5");
-    return m_volumes[m_options.anisotropic ? f : 0];
+    set.writeSampledImage(first + 1, m_filtered.view(), m_sampler.handle(), general);
+    set.writeSampledImage(first + 2, m_normalView, m_sampler.handle(), m_normalLayout);
 }
 
 std::vector<glm::vec4> VoxelRadiance::readLevel(uint32_t level, int faceIndex) {
@@ -195,12 +201,16 @@ std::vector<glm::vec4> VoxelRadiance::readLevel(uint32_t level, int faceIndex) {
         throw Error("VoxelRadiance::readLevel: face = " + std::to_string(faceIndex) +
                     " outside [0, 5]");
     }
-    std::vector<float> f = level == 0
-                               ? m_base.readbackFloat(m_ctx)
-                               : face(uint32_t(faceIndex)).readbackFloat(m_ctx, 0, level - 1);
-    std::vector<glm::vec4> out(f.size() / 4);
-    for (size_t i = 0; i < out.size(); ++i)
-        out[i] = glm::vec4(f[4 * i], f[4 * i + 1], f[4 * i + 2], f[4 * i + 3]);
+    std::vector<float> f =
+        level == 0 ? m_base.readbackFloat(m_ctx) : m_filtered.readbackFloat(m_ctx, 0, level - 1);
+    // A face's slab is a contiguous z range of its level: texels [slab n^3, (slab + 1) n^3)
+    const size_t n = size_t(m_grid.resolution() >> level);
+    const size_t first = level == 0 ? 0 : size_t(m_options.anisotropic ? faceIndex : 0) * n * n * n;
+    std::vector<glm::vec4> out(n * n * n);
+    for (size_t i = 0; i < out.size(); ++i) {
+        const float* t = &f[4 * (first + i)];
+        out[i] = glm::vec4(t[0], t[1], t[2], t[3]);
+    }
     return out;
 }
 

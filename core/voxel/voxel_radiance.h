@@ -7,9 +7,16 @@
  * filter(): anisotropic (default): 6 directional volumes -X,+X,-Y,+Y,-Z,+Z at (N/2)^3 with a full
  *          mip chain down to 1^3; each value is the average over the 4 pairs of children along
  *          the face's axis of front + (1 - front.a) back (Crassin §9, notes 003 E5, §7.3).
+ *          The six are slabs of one atlas volume (N/2, N/2, 6 N/2) with mips, face f at z in
+ *          [f n, (f + 1) n) of each level: a cone picks its face by coordinates, not by a branch
+ *          (lavapipe runs both sides of a branch; docs/voxel_cone_tracing.md "Speed").
  *          Isotropic: one (N/2)^3 volume + mips, Box (2x2x2 average) or Gaussian (separable
  *          [1,3,3,1]/8 around the 2x2x2 block, the cell-centred analogue of Crassin §4.2.3).
  *          One compute dispatch per level, each followed by a barrier.
+ * Facing (Crassin §7, issue 9): with setSurfaceNormals(), a voxel's radiance is seen only from
+ * the side its averaged surface normal faces (shaders/common/voxel_facing.glsl): the directional
+ * level 0 is built from facing-weighted children, and base samples are weighted the same way.
+ * Without it (or where a voxel has no normal) radiance is isotropic.
  * Shaders read everything through combined image samplers (trilinear, mipmap linear, clamp to
  * transparent-black border), bindings as addLayoutBindings / shaders/common/voxel_cone_dense.glsl.
  * Memory is tagged with the caller's tag ("<tag>/base", "<tag>/face-X", ...).
@@ -46,7 +53,7 @@ struct VoxelRadianceOptions {
 class VoxelRadiance {
 public:
     static constexpr uint32_t kFaceCount = 6;
-    static constexpr uint32_t kBindingCount = 1 + kFaceCount;
+    static constexpr uint32_t kBindingCount = 3;  // base, filtered atlas, surface normals
 
     VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid, const VoxelRadianceOptions& options,
                   const std::string& memoryTag);  // e.g. ctx.tag("radiance")
@@ -57,6 +64,12 @@ public:
      *  Techniques write it with imageStore (declare layout(rgba16f) / rgba32f per format()). */
     vk::Image& base() { return m_base; }
     VkFormat format() const { return m_format; }
+    /** The voxelizer's averaged-normal volume (N^3, xyz unit, w length; SHADER_READ_ONLY_OPTIMAL
+     *  when filtered and traced): radiance then faces its surface's side. Call before filter()
+     *  and writeDescriptors(). */
+    void setSurfaceNormals(const vk::Image& normals);
+    bool hasSurfaceNormals() const { return m_normalView != m_noNormals.view(); }
+
     /** Zeroes the base volume (transparent black), then a barrier. */
     void clearBase(VkCommandBuffer cmd);
     /** Barrier after the caller's writes to base(), then the mip passes; leaves everything readable
@@ -70,8 +83,9 @@ public:
     const VoxelGrid& grid() const { return m_grid; }
     const VoxelRadianceOptions& options() const { return m_options; }
 
-    /** Bindings for shaders/common/voxel_cone_dense.glsl: first = base, first+1..first+6 = faces
-     *  -X,+X,-Y,+Y,-Z,+Z (isotropic volume repeated when !anisotropic). Combined image samplers. */
+    /** Bindings for shaders/common/voxel_cone_dense.glsl: first = base, first+1 = the filtered
+     *  atlas (6 face slabs -X,+X,-Y,+Y,-Z,+Z, or 1 isotropic slab), first+2 = surface normals (a
+     *  zero 1^3 volume without setSurfaceNormals). Combined image samplers. */
     static void addLayoutBindings(std::vector<VkDescriptorSetLayoutBinding>& out, uint32_t first,
                                   VkShaderStageFlags stages);
     /** Same bindings in the vk::DescriptorSetLayout form. */
@@ -80,8 +94,8 @@ public:
     void writeDescriptors(vk::DescriptorSet& set, uint32_t first) const;
     /** The sampler used for every binding (trilinear, clamp to transparent-black border). */
     VkSampler sampler() const { return m_sampler.handle(); }
-    /** Directional volume `face` (0..5); the isotropic volume for every face when !anisotropic. */
-    vk::Image& face(uint32_t face);
+    /** Face slabs in the filtered atlas: 6 (anisotropic) or 1 (isotropic). */
+    uint32_t slabCount() const { return m_options.anisotropic ? kFaceCount : 1; }
 
     /** Tests: level 0 = base, level l >= 1 = filtered level l-1 of `face` (0..5; ignored if
      *  isotropic). x + n (y + n z) order. Blocking. */
@@ -93,8 +107,11 @@ private:
     VoxelRadianceOptions m_options;
     VkFormat m_format = VK_FORMAT_R16G16B16A16_SFLOAT;
     vk::Image m_base;
-    std::vector<vk::Image> m_volumes;  // 6 faces (anisotropic) or 1 (isotropic)
+    vk::Image m_filtered;  // atlas: slabCount() slabs of (N/2)^3 stacked in z, with mips
     vk::Sampler m_sampler;
+    vk::Image m_noNormals;  // 1^3 zero: no facing
+    VkImageView m_normalView = VK_NULL_HANDLE;
+    VkImageLayout m_normalLayout = VK_IMAGE_LAYOUT_GENERAL;
     vk::DescriptorSetLayout m_setLayout;
     vk::PipelineLayout m_pipelineLayout;
     vk::ComputePipeline m_firstLevel;       // base -> level 0 of the filtered volumes

@@ -61,7 +61,8 @@ int runMain(int argc, char** argv) {
         ->check(CLI::Range(1, 100000))
         ->capture_default_str();
     rend->add_option("--device", render.device, "Vulkan device name substring or index");
-    rend->add_flag("--validation", render.validation, "Enable Vulkan validation layers");
+    rend->add_flag("--validation", render.validation,
+                   "Enable Vulkan validation layers (any message: status invalid, exit code 5)");
     rend->add_flag("--quiet,-q", render.quiet, "No progress lines");
 
     ReferenceOptions reference;
@@ -159,7 +160,9 @@ int runMain(int argc, char** argv) {
                        "Reference cache folder (default: $GILAB_REFERENCE_CACHE or "
                        "results/cache/reference)");
     runCmd->add_option("--device", run.device, "Vulkan device name substring or index");
-    runCmd->add_flag("--validation", run.validation, "Enable Vulkan validation layers");
+    runCmd->add_flag("--validation", run.validation,
+                     "Enable Vulkan validation layers (any message: the run is invalid, exit "
+                     "code 5 at the end)");
     runCmd->add_flag("--dry-run", run.dryRun, "List the runs and which are finished; run nothing");
     runCmd->add_flag("--quiet,-q", run.quiet, "No progress lines");
 

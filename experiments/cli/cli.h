@@ -20,7 +20,13 @@ enum ExitCode : int {
     kExitUsage = 2,        // bad command line
     kExitUnsupported = 3,  // the technique cannot run on this scene (reason printed and saved)
     kExitNonFinite = 4,    // the run finished but an output has NaN/Inf pixels (counted, saved)
+    kExitInvalid = 5,      // validation was on and reported an error or warning (messages saved)
 };
+
+/** The exit code of a run with this status ("ok", "nonfinite", "unsupported", "invalid"). */
+int exitCodeForStatus(const std::string& status);
+/** The exit code of `gilab run` after all its runs: interrupted, then invalid, then nonfinite. */
+int runExitCode(const exp::RunnerSummary& summary, bool interrupted);
 
 int runMain(int argc, char** argv);
 

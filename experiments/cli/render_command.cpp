@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 
 #include "core/image/image_io.h"
 #include "core/passes/shared_passes.h"
@@ -13,6 +14,7 @@
 #include "core/vk/context.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_store.h"
 
 namespace gilab::cli {
 namespace {
@@ -29,7 +31,35 @@ void applyAssignments(const std::vector<std::string>& assignments, ParamSet& tec
     }
 }
 
+/** Prints the validation summary of a run that reported messages (they are in the sidecar). */
+void reportValidation(const nlohmann::ordered_json& validation, const std::string& jsonPath) {
+    if (validationMessageCount(validation) == 0) return;
+    std::fprintf(stderr,
+                 "gilab: invalid: %u Vulkan validation errors and %u warnings during the run "
+                 "(messages in %s)\n",
+                 validation["errors"].get<uint32_t>(), validation["warnings"].get<uint32_t>(),
+                 jsonPath.c_str());
+}
+
+/** Adds the run's validation messages and its final status to the sidecar and writes it. */
+std::string finishSidecar(vk::Context& ctx, nlohmann::ordered_json& meta,
+                          const std::string& jsonPath, exp::RunOutcome outcome) {
+    meta["validation"] = takeValidationJson(ctx);
+    outcome.validationMessages = validationMessageCount(meta["validation"]);
+    meta["status"] = exp::runStatus(outcome);
+    writeJsonAtomic(jsonPath, meta);
+    return meta["status"];
+}
+
 }  // namespace
+
+int exitCodeForStatus(const std::string& status) {
+    if (status == "ok") return kExitOk;
+    if (status == "nonfinite") return kExitNonFinite;
+    if (status == "unsupported") return kExitUnsupported;
+    if (status == "invalid") return kExitInvalid;
+    return kExitError;
+}
 
 int runRender(const RenderOptions& options) {
     Progress::setQuiet(options.quiet);
@@ -64,48 +94,49 @@ int runRender(const RenderOptions& options) {
         {"params", params.toOrderedJson()}};
     meta["shared_params"] = shared.toOrderedJson();
 
-    FrameHarness harness(ctx, scene, options.technique, params, shared);
-    if (!harness.support().supported) {
-        meta["status"] = "unsupported";
-        meta["reason"] = harness.support().reason;
-        writeJsonAtomic(base.string() + ".json", meta);
+    const std::string jsonPath = base.string() + ".json";
+    // Destroyed before the validation messages are collected, so they include its teardown.
+    auto harness = std::make_unique<FrameHarness>(ctx, scene, options.technique, params, shared);
+    if (!harness->support().supported) {
+        meta["reason"] = harness->support().reason;
+        harness.reset();
         std::fprintf(stderr, "gilab: %s skipped on %s: %s\n", options.technique.c_str(),
-                     scene.name.c_str(), harness.support().reason.c_str());
-        return kExitUnsupported;
+                     scene.name.c_str(), meta["reason"].get<std::string>().c_str());
+        const std::string status = finishSidecar(ctx, meta, jsonPath, {.supported = false});
+        reportValidation(meta["validation"], jsonPath);
+        return exitCodeForStatus(status);
     }
 
     Progress setupProgress("set-up " + options.technique + " on " + scene.name);
-    const SetupTiming setup = harness.setup();
+    const SetupTiming setup = harness->setup();
     setupProgress.finish();
 
     const int total = options.warmupFrames + options.frames;
     std::vector<FrameTiming> frames;
     Progress frameProgress("frames", size_t(total));
     for (int i = 0; i < total; ++i) {
-        FrameTiming t = harness.renderFrame();
+        FrameTiming t = harness->renderFrame();
         if (i >= options.warmupFrames) frames.push_back(std::move(t));
         frameProgress.update(size_t(i + 1));
     }
     frameProgress.finish();
 
-    const std::vector<ImageLayer> layers = harness.readLayers();
+    const std::vector<ImageLayer> layers = harness->readLayers();
     size_t nonFinite = 0;
     meta["nonfinite"] = finiteJson(layers, &nonFinite);
     meta["timing"] = timingJson(setup, frames, options.warmupFrames);
-    meta["memory"] = memoryJson(harness.memory());
-    meta["skipped_passes"] = harness.skipped();
-    meta["notes"] = harness.notes();
-    meta["validation"] = {{"errors", ctx.validationErrorCount()},
-                          {"warnings", ctx.validationWarningCount()},
-                          {"messages", ctx.validationMessages()}};
+    meta["memory"] = memoryJson(harness->memory());
+    meta["skipped_passes"] = harness->skipped();
+    meta["notes"] = harness->notes();
+    harness.reset();
 
     writeExrLayers(base.string() + ".exr", layers);
     ToneMap tm;
     tm.exposureEv = scene.settings.exposureEv;
     writePngTonemapped(base.string() + ".png", layers.front().image, tm);
     meta["outputs"] = {{"exr", base.string() + ".exr"}, {"png", base.string() + ".png"}};
-    meta["status"] = nonFinite ? "nonfinite" : "ok";
-    writeJsonAtomic(base.string() + ".json", meta);
+    const std::string status =
+        finishSidecar(ctx, meta, jsonPath, {.supported = true, .nonFinitePixels = nonFinite});
 
     const auto& cpu = meta["timing"]["frame_cpu_ms"];
     const auto& gpu = meta["timing"]["frame_gpu_ms"];
@@ -116,19 +147,15 @@ int runRender(const RenderOptions& options) {
         ctx.deviceName().c_str(), setup.totalMs,
         cpu["median"].is_number() ? cpu["median"].get<double>() : -1.0,
         gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
-    for (const std::string& s : harness.skipped())
-        std::printf("  skipped %s\n", s.c_str());
+    for (const auto& skipped : meta["skipped_passes"])
+        std::printf("  skipped %s\n", skipped.get<std::string>().c_str());
     std::printf("  wrote %s.{exr,png,json}\n", base.string().c_str());
-    if (ctx.validationErrorCount() > 0)
-        std::fprintf(stderr, "gilab: %u Vulkan validation errors (see the JSON sidecar)\n",
-                     ctx.validationErrorCount());
-    if (nonFinite) {
+    if (nonFinite)
         std::fprintf(stderr,
                      "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s.json)\n",
                      nonFinite, base.string().c_str());
-        return kExitNonFinite;
-    }
-    return kExitOk;
+    reportValidation(meta["validation"], jsonPath);
+    return exitCodeForStatus(status);
 }
 
 }  // namespace gilab::cli

@@ -14,6 +14,12 @@
 
 namespace gilab::cli {
 
+int runExitCode(const exp::RunnerSummary& s, bool interrupted) {
+    if (s.cancelled || interrupted) return kExitInterrupted;
+    if (s.invalid > 0 || s.validationOutsideRuns > 0) return kExitInvalid;
+    return s.nonfinite ? kExitNonFinite : kExitOk;
+}
+
 int runExperimentCommand(const exp::RunnerOptions& options) {
     InterruptScope interrupt(
         "\ngilab: interrupted: stopping after the current run; finished runs are kept "
@@ -22,12 +28,16 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
     if (options.dryRun) return kExitOk;
     std::printf(
         "%s: %zu runs (%zu in this shard): %zu already finished, %zu ran (%zu unsupported, "
-        "%zu with non-finite pixels)%s\n",
+        "%zu with non-finite pixels, %zu invalid)%s\n",
         s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.ran, s.unsupported,
-        s.nonfinite, s.cancelled ? ", interrupted" : "");
+        s.nonfinite, s.invalid, s.cancelled ? ", interrupted" : "");
+    if (s.invalid > 0)
+        std::fprintf(stderr,
+                     "gilab: %zu invalid runs: Vulkan validation reported errors or warnings "
+                     "(status \"invalid\" in their result.json; redone on the next run)\n",
+                     s.invalid);
     std::printf("report: gilab report %s\n", s.dir.string().c_str());
-    if (s.cancelled || interrupt.interrupted()) return kExitInterrupted;
-    return s.nonfinite ? kExitNonFinite : kExitOk;
+    return runExitCode(s, interrupt.interrupted());
 }
 
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {

@@ -85,6 +85,24 @@ nlohmann::ordered_json deviceJson(const vk::Context& ctx) {
             {"candidates", candidates}};
 }
 
+nlohmann::ordered_json takeValidationJson(vk::Context& ctx) {
+    nlohmann::ordered_json json = {{"enabled", ctx.validationEnabled()},
+                                   {"errors", ctx.validationErrorCount()},
+                                   {"warnings", ctx.validationWarningCount()},
+                                   {"messages", ctx.validationMessages()}};
+    ctx.clearValidationMessages();
+    return json;
+}
+
+uint32_t validationMessageCount(const nlohmann::ordered_json& validation) {
+    auto count = [&](const char* key) {
+        const auto it = validation.find(key);  // end() when not an object
+        const bool counted = it != validation.end() && it->is_number_integer() && *it >= 0;
+        return counted ? it->get<uint32_t>() : 0u;
+    };
+    return count("errors") + count("warnings");
+}
+
 nlohmann::ordered_json sceneToJson(const Scene& scene) {
     const SceneCaps& c = scene.caps;
     nlohmann::ordered_json features = nlohmann::ordered_json::array();

@@ -1,5 +1,6 @@
 #pragma once
 /** JSON blocks shared by every output sidecar: provenance, device, scene, timings, memory. */
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -24,6 +25,13 @@ nlohmann::ordered_json sceneToJson(const Scene& scene);
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
                                   int warmupFrames);
 nlohmann::ordered_json memoryJson(const MemoryReport& memory);
+/**
+ * The Vulkan validation messages captured since the last call (or since the context was made):
+ * {enabled, errors, warnings, messages}. Clears them, so each run reports only its own.
+ */
+nlohmann::ordered_json takeValidationJson(vk::Context& ctx);
+/** errors + warnings of a takeValidationJson() block (0 for anything else). */
+uint32_t validationMessageCount(const nlohmann::ordered_json& validation);
 /** {layer: {nan, inf, negative}} and the total non-finite pixel count in `*nonFinite`. */
 nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t* nonFinite);
 std::string isoDateUtc();

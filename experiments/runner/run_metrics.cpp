@@ -66,6 +66,10 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
             ro.referenceStdError = &reference.finalStdError;
             nlohmann::ordered_json entry;
             entry["pixels"] = ro.mask->count();
+            // The indirect energy of this region alone (e.g. a surface lit only indirectly)
+            const double regionEnergy = metrics::computeEnergyRatio(indirect, refIndirect, &*ro.mask);
+            entry["energy_ratio"] =
+                std::isfinite(regionEnergy) ? nlohmann::ordered_json(regionEnergy) : nullptr;
             entry["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, ro));
             if (bounces != 0 && !reference.indirect.empty()) {
                 ro.referenceStdError = &reference.indirectStdError;

@@ -72,6 +72,8 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
             {"params", params},
             {"status", at({"status"})},
             {"reason", at({"reason"})},
+            {"validation_errors", at({"validation", "errors"})},
+            {"validation_warnings", at({"validation", "warnings"})},
             {"setup_ms", at({"timing", "setup_ms", "total"})},
             {"frame_cpu_ms_median", at({"timing", "frame_cpu_ms", "median"})},
             {"frame_cpu_ms_iqr", at({"timing", "frame_cpu_ms", "iqr"})},
@@ -100,6 +102,16 @@ bool isFinalStatus(const std::string& status) {
     return status == "ok" || status == "nonfinite" || status == "unsupported";
 }
 
+bool isStoredStatus(const std::string& status) {
+    return isFinalStatus(status) || status == "invalid";
+}
+
+std::string runStatus(const RunOutcome& outcome) {
+    if (outcome.validationMessages > 0) return "invalid";
+    if (!outcome.supported) return "unsupported";
+    return outcome.nonFinitePixels > 0 ? "nonfinite" : "ok";
+}
+
 void flattenJson(const nlohmann::json& value, const std::string& prefix,
                  std::vector<std::pair<std::string, std::string>>& out) {
     if (value.is_object()) {
@@ -122,16 +134,20 @@ fs::path RunStore::runDir(const std::string& key) const {
     return m_dir / "runs" / key;
 }
 
-bool RunStore::isFinished(const std::string& key) const {
+std::string RunStore::storedStatus(const std::string& key) const {
     const fs::path result = runDir(key) / "result.json";
-    if (!fs::exists(result)) return false;
+    if (!fs::exists(result)) return "";
     try {
         std::ifstream in(result);
         const nlohmann::json j = nlohmann::json::parse(in);
-        return isFinalStatus(j.value("status", ""));
+        return j.value("status", "");
     } catch (const std::exception&) {
-        return false;  // unreadable: redo the run
+        return "";  // unreadable: redo the run
     }
+}
+
+bool RunStore::isFinished(const std::string& key) const {
+    return isFinalStatus(storedStatus(key));
 }
 
 fs::path RunStore::beginRun(const std::string& key) const {
@@ -202,7 +218,7 @@ std::vector<nlohmann::json> RunStore::loadFinished() const {
         try {
             std::ifstream in(result);
             nlohmann::json j = nlohmann::json::parse(in);
-            if (isFinalStatus(j.value("status", ""))) out.push_back(std::move(j));
+            if (isStoredStatus(j.value("status", ""))) out.push_back(std::move(j));
         } catch (const std::exception&) {
         }
     }

@@ -11,6 +11,8 @@
  * A run's key is a hash of its resolved configuration: re-running a config skips keys whose
  * folder holds a finished result.json and redoes only what changed.
  */
+#include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -27,6 +29,8 @@ public:
 
     const std::filesystem::path& dir() const { return m_dir; }
     std::filesystem::path runDir(const std::string& key) const;
+    /** The status recorded in runs/<key>/result.json; "" when missing or unreadable. */
+    std::string storedStatus(const std::string& key) const;
     /** True when runs/<key>/result.json exists and records a final status. */
     bool isFinished(const std::string& key) const;
 
@@ -38,7 +42,7 @@ public:
     /** Appends one row to results.jsonl and results.csv (flushed and synced). */
     void appendRow(const nlohmann::ordered_json& row) const;
 
-    /** Every finished run's result.json, sorted by run index then key. */
+    /** Every stored run's result.json (final or invalid), sorted by run index then key. */
     std::vector<nlohmann::json> loadFinished() const;
 
 private:
@@ -47,6 +51,21 @@ private:
 
 /** Statuses that mark a run as done (not retried): "ok", "nonfinite", "unsupported". */
 bool isFinalStatus(const std::string& status);
+/** Statuses of a committed run folder: the final ones and "invalid" (kept, but redone on the
+ *  next `gilab run`, so a fixed technique is measured again). */
+bool isStoredStatus(const std::string& status);
+
+/** What decides a run's status once it has been attempted. */
+struct RunOutcome {
+    bool supported = true;            // false: nothing was rendered (the reason is saved)
+    size_t nonFinitePixels = 0;       // NaN/Inf pixels over all output layers
+    uint32_t validationMessages = 0;  // Vulkan validation errors + warnings during the run
+};
+/**
+ * "invalid" when validation reported any message (results of an invalid API use are not
+ * trusted), else "unsupported", "nonfinite" or "ok".
+ */
+std::string runStatus(const RunOutcome& outcome);
 
 /** Flattens nested objects to "a.b.c" columns for CSV (arrays are JSON-encoded in one cell). */
 void flattenJson(const nlohmann::json& value, const std::string& prefix,
@@ -57,7 +76,8 @@ std::string sanitizeLabel(const std::string& label);
 
 /**
  * The flat row of the results tables for a run's result.json: identity, parameters (as
- * "k=v ..."), status, set-up and frame times, memory, the headline metrics, provenance.
+ * "k=v ..."), status, validation counts, set-up and frame times, memory, the headline metrics,
+ * provenance.
  */
 nlohmann::ordered_json resultRow(const nlohmann::ordered_json& result);
 

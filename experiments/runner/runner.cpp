@@ -118,8 +118,32 @@ nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry
             {"final_exr", "../../references/" + safeLabel + "/" + m.name + ".exr"}};
 }
 
-std::string statusOf(size_t nonFinite) {
-    return nonFinite ? "nonfinite" : "ok";
+/** Prints where the messages of an invalid run are (the first ones went to stderr already). */
+void reportInvalid(const nlohmann::ordered_json& result, const fs::path& runDir) {
+    const auto& v = result["validation"];
+    std::fprintf(stderr,
+                 "gilab: run %zu (%s on %s) is invalid: %u Vulkan validation errors and %u "
+                 "warnings (messages in %s)\n",
+                 result["index"].get<size_t>(),
+                 result["technique"]["id"].get<std::string>().c_str(),
+                 result["scene"]["label"].get<std::string>().c_str(), v["errors"].get<uint32_t>(),
+                 v["warnings"].get<uint32_t>(), (runDir / "result.json").string().c_str());
+}
+
+/**
+ * Adds the run's validation messages and final status to `result`, writes result.json, commits
+ * the run folder and appends its row. Returns the status.
+ */
+std::string commitResult(Context& c, nlohmann::ordered_json& result, const fs::path& tmp,
+                         const std::string& key, RunOutcome outcome) {
+    result["validation"] = cli::takeValidationJson(c.vk);
+    outcome.validationMessages = cli::validationMessageCount(result["validation"]);
+    result["status"] = runStatus(outcome);
+    writeFileAtomic(tmp / "result.json", result.dump(2));
+    c.store.commitRun(tmp, key);
+    c.store.appendRow(resultRow(result));
+    if (result["status"] == "invalid") reportInvalid(result, c.store.runDir(key));
+    return result["status"];
 }
 
 /** Executes one run into a temporary folder and commits it. Returns its status. */
@@ -153,14 +177,13 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["config_hash"] = c.configHash;
     result["device"] = cli::deviceJson(c.vk);
 
-    FrameHarness harness(c.vk, scene, run.techniqueId, run.params, run.shared);
-    if (!harness.support().supported) {
-        result["status"] = "unsupported";
-        result["reason"] = harness.support().reason;
-        writeFileAtomic(tmp / "result.json", result.dump(2));
-        c.store.commitRun(tmp, key);
-        c.store.appendRow(resultRow(result));
-        return "unsupported";
+    // Destroyed before the validation messages are collected, so they include its teardown.
+    auto harness =
+        std::make_unique<FrameHarness>(c.vk, scene, run.techniqueId, run.params, run.shared);
+    if (!harness->support().supported) {
+        result["reason"] = harness->support().reason;
+        harness.reset();
+        return commitResult(c, result, tmp, key, {.supported = false});
     }
 
     const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
@@ -176,28 +199,27 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
                           info.id + " on " + run.scene->label,
                       size_t(c.config.timing.warmupFrames + c.config.timing.timedFrames));
-    const SetupTiming setup = harness.setup();
+    const SetupTiming setup = harness->setup();
     std::vector<FrameTiming> frames;
     const int total = c.config.timing.warmupFrames + c.config.timing.timedFrames;
     for (int i = 0; i < total; ++i) {
-        FrameTiming t = harness.renderFrame();
+        FrameTiming t = harness->renderFrame();
         if (i >= c.config.timing.warmupFrames) frames.push_back(std::move(t));
         progress.update(size_t(i + 1));
     }
     progress.finish();
 
-    const std::vector<ImageLayer> layers = harness.readLayers();
+    const std::vector<ImageLayer> layers = harness->readLayers();
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
     result["timing"] = cli::timingJson(setup, frames, c.config.timing.warmupFrames);
-    result["memory"] = cli::memoryJson(harness.memory());
-    result["skipped_passes"] = harness.skipped();
-    result["notes"] = harness.notes();
+    result["memory"] = cli::memoryJson(harness->memory());
+    result["skipped_passes"] = harness->skipped();
+    result["notes"] = harness->notes();
+    harness.reset();
     result["metrics"] = computeRunMetrics(layers, matched, claimedBounces(info, run.params),
                                           c.config.metrics, tm, tmp);
     result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
-    result["validation"] = {{"errors", c.vk.validationErrorCount()},
-                            {"warnings", c.vk.validationWarningCount()}};
 
     writeExrLayers((tmp / "output.exr").string(), layers);
     writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
@@ -206,11 +228,14 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                          {"final_png", "final.png"},
                          {"indirect_png", "indirect.png"},
                          {"flip_png", "flip.png"}};
-    result["status"] = statusOf(nonFinite);
-    writeFileAtomic(tmp / "result.json", result.dump(2));
-    c.store.commitRun(tmp, key);
-    c.store.appendRow(resultRow(result));
-    return result["status"];
+    return commitResult(c, result, tmp, key, {.supported = true, .nonFinitePixels = nonFinite});
+}
+
+/** "[done]", "[todo]", or "[todo: invalid]" for a stored invalid run (redone). */
+const char* dryRunState(const RunStore& store, const std::string& key) {
+    const std::string status = store.storedStatus(key);
+    if (isFinalStatus(status)) return "[done]";
+    return status == "invalid" ? "[todo: invalid]" : "[todo]";
 }
 
 }  // namespace
@@ -263,7 +288,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
             std::printf("%4zu %s %-12s %-24s %s %s\n", mine[i]->index,
                         keys[i].substr(0, 12).c_str(), mine[i]->techniqueId.c_str(),
                         mine[i]->scene->label.c_str(), mine[i]->params.toString().c_str(),
-                        store.isFinished(keys[i]) ? "[done]" : "[todo]");
+                        dryRunState(store, keys[i]));
         return summary;
     }
 
@@ -285,6 +310,14 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
     experiment["device"] = cli::deviceJson(vk);
     experiment["instrumentation"] =
         measureInstrumentationOverhead(vk, probeScenes.get(config.scenes.front()));
+    experiment["validation"] = cli::takeValidationJson(vk);  // before the runs: the probe's
+    summary.validationOutsideRuns = cli::validationMessageCount(experiment["validation"]);
+    if (summary.validationOutsideRuns > 0)
+        std::fprintf(stderr,
+                     "gilab: %u Vulkan validation messages before the runs (timestamp probe; "
+                     "see \"validation\" in %s)\n",
+                     summary.validationOutsideRuns,
+                     (summary.dir / "experiment.json").string().c_str());
     writeFileAtomic(summary.dir / ("experiment.json"), experiment.dump(2));
 
     Context c{config, options, store, vk,     cache.get(),
@@ -302,6 +335,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
         ++summary.ran;
         if (status == "unsupported") ++summary.unsupported;
         if (status == "nonfinite") ++summary.nonfinite;
+        if (status == "invalid") ++summary.invalid;
     }
     return summary;
 }

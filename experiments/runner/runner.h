@@ -7,6 +7,7 @@
  * results tables. Killing the process loses no finished run.
  */
 #include <atomic>
+#include <cstdint>
 #include <filesystem>
 #include <string>
 
@@ -33,6 +34,8 @@ struct RunnerSummary {
     size_t ran = 0;
     size_t unsupported = 0;
     size_t nonfinite = 0;
+    size_t invalid = 0;  // runs with Vulkan validation messages (stored, redone next time)
+    uint32_t validationOutsideRuns = 0;  // messages before the runs (the timestamp probe)
     bool cancelled = false;
 };
 

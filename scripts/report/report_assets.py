@@ -32,6 +32,7 @@ table.meta td:first-child { color: var(--muted); white-space: nowrap; }
 .st-nonfinite { background: #fde9d7; color: #8a3b00; }
 .st-unsupported { background: #ececec; color: #444; }
 .st-unreadable { background: #f8d7da; color: #842029; }
+.st-invalid { background: #b3261e; color: #fff; font-weight: 600; }
 .b-best { background: #0b5cad; color: #fff; }
 .b-noise { background: #e3f3e6; color: #17602a; }
 .b-front { background: #fff3c4; color: #6b5200; }
@@ -67,6 +68,7 @@ table.data th { background: #f0f0f0; position: sticky; top: 0; white-space: nowr
 table.data td.n { text-align: right; white-space: nowrap; }
 table.data tr:nth-child(even) td { background: #fafafa; }
 table.data tr.noise td { background: #eef8f0; }
+table.data tr.invalid td { background: #fdecea; }
 table.sortable th { cursor: pointer; user-select: none; }
 table.sortable th::after { content: " \\2195"; color: #aaa; font-weight: 400; }
 table.sortable th[aria-sort=ascending]::after { content: " \\25B2"; color: #333; }
@@ -89,6 +91,9 @@ footer { margin-top: 40px; font-size: 12px; color: #333; }
 footer dt { font-weight: 600; margin-top: 6px; }
 footer dd { margin-left: 16px; max-width: 980px; }
 .warn { background: #fff4e5; border-left: 4px solid #e69f00; padding: 6px 10px; }
+.warn.invalid { background: #fdecea; border-left-color: #b3261e; margin: 12px 0; }
+.warn.invalid li { margin: 3px 0; }
+code.vmsg { white-space: pre-wrap; overflow-wrap: anywhere; display: inline-block; }
 .empty { padding: 30px; background: var(--bg2); border-radius: 6px; font-size: 16px; }
 """
 

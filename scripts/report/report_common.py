@@ -153,5 +153,27 @@ def nonfinite_count(run: Run) -> Optional[float]:
     return run.final.test_nonfinite
 
 
+MESSAGE_CHARS = 300  # a validation message is cut here on the page (full text in result.json)
+
+
+def validation_summary(run: Run) -> str:
+    """'N validation errors, M warnings' of a run (HTML-escaped), '' when none were recorded."""
+    errors, warnings = run.validation_counts()
+    if errors is None and warnings is None:
+        return ""
+    parts = [f"{int(n)} {what}{'s' if n != 1 else ''}"
+             for n, what in ((errors or 0, "validation error"), (warnings or 0, "warning"))]
+    return esc(", ".join(parts))
+
+
+def first_message_html(run: Run) -> str:
+    """The run's first validation message, cut to MESSAGE_CHARS, in <code> ('' when none)."""
+    message = run.first_validation_message()
+    if not message:
+        return ""
+    cut = message if len(message) <= MESSAGE_CHARS else message[:MESSAGE_CHARS] + "…"
+    return f'<code class="vmsg" title="{esc(message)}">{esc(cut)}</code>'
+
+
 def scene_anchor(scene: str) -> str:
     return "scene-" + slug(scene)

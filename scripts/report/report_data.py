@@ -16,7 +16,9 @@ import os
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Optional
 
-FINAL_STATUSES = ("ok", "nonfinite", "unsupported")
+# Statuses of a committed run folder. "invalid": Vulkan validation reported an error or warning
+# during the run; its numbers are shown but never ranked (docs/report.md).
+RUN_STATUSES = ("ok", "nonfinite", "unsupported", "invalid")
 
 # Key names of a metric set M: the C++ toJson's spelling (docs/metrics.md, "JSON") first, then
 # other spellings that earlier drafts of the schema used.
@@ -149,8 +151,19 @@ class Run:
 
     @property
     def measured(self) -> bool:
-        """Has images and numbers (ok or nonfinite)."""
+        """Has images and numbers to compare (ok or nonfinite; invalid runs are not trusted)."""
         return self.status in ("ok", "nonfinite")
+
+    def validation_counts(self) -> tuple[Optional[float], Optional[float]]:
+        """(errors, warnings) reported by Vulkan validation during the run (None = unknown)."""
+        return (num(dig(self.data, "validation", "errors")),
+                num(dig(self.data, "validation", "warnings")))
+
+    def first_validation_message(self) -> str:
+        """The first validation message recorded, '' when there is none."""
+        messages = dig(self.data, "validation", "messages")
+        first = messages[0] if isinstance(messages, list) and messages else None
+        return first if isinstance(first, str) else ""
 
     def passes(self) -> list[tuple[str, Optional[float]]]:
         """Per-frame passes in recorded order: (name, median GPU ms)."""
@@ -187,7 +200,7 @@ class Run:
 
 @dataclass
 class Unreadable:
-    """A run folder whose result.json is missing, malformed or has no final status."""
+    """A run folder whose result.json is missing, malformed or has no known status."""
 
     path: str
     why: str
@@ -280,8 +293,8 @@ def _read_run_folder(folder: str, results_dir: str) -> Run | Unreadable:
     if not isinstance(data, dict):
         return Unreadable(path, "result.json is not a JSON object")
     status = data.get("status")
-    if status not in FINAL_STATUSES:
-        return Unreadable(path, f"status {status!r} is not one of {', '.join(FINAL_STATUSES)}")
+    if status not in RUN_STATUSES:
+        return Unreadable(path, f"status {status!r} is not one of {', '.join(RUN_STATUSES)}")
     return parse_run(data, folder, results_dir)
 
 

@@ -13,7 +13,7 @@ from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, esc,
                            rel_url, scene_anchor, status_badge, swatch, with_bar)
 from report_data import Run, dig, num, text
 from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
-                           run_table_html, skipped_html, unreadable_html)
+                           invalid_banner_html, run_table_html, skipped_html, unreadable_html)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -116,6 +116,12 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
         note = (f'<p class="note">{len(unsupported)} unsupported run(s) on this scene: '
                 + "; ".join(f"{esc(r.technique)} ({esc(params_text(r, True)) or DASH}): "
                             f"{esc(r.reason) or DASH}" for r in unsupported) + "</p>")
+    invalid = [r for r in runs if r.status == "invalid"]
+    if invalid:
+        note += (f'<p class="note">{len(invalid)} invalid run(s) on this scene, not shown '
+                 '(Vulkan validation messages, see the warning at the top): '
+                 + "; ".join(f"{esc(r.technique)} ({esc(params_text(r, True)) or DASH})"
+                             for r in invalid) + "</p>")
     title = (f'<h3>{esc(scene)} <span class="muted">{esc(_scene_resolution(runs))}</span>'
              '</h3>')
     if not measured:
@@ -259,7 +265,8 @@ NAV_TITLES = (("images", "Images"), ("runs", "All runs"), ("pareto", "Error vs. 
 
 
 def render_page(page: Page) -> str:
-    sections = [scenes_html(page), run_table_html(page) + failures_html(page), pareto_html(page),
+    sections = [invalid_banner_html(page), scenes_html(page),
+                run_table_html(page) + failures_html(page), pareto_html(page),
                 sweeps_html(page), passes_html(page), equal_html(page), skipped_html(page),
                 unreadable_html(page)]
     body = "".join(sections)

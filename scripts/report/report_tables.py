@@ -11,8 +11,9 @@ from typing import Callable, Optional
 from report_analysis import (MIN_COMPARED, best_within_budget, by_scene, by_technique,
                              cheapest_reaching, comparable_groups, error_targets, ordered_unique,
                              params_text, slug, time_budgets)
-from report_common import (DASH, MIB, Page, doc_link, esc, fmt_fixed, fmt_flip, fmt_ms, fmt_sig,
-                           nonfinite_count, params_html, status_badge, swatch, with_bar)
+from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html, fmt_fixed,
+                           fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, status_badge,
+                           swatch, validation_summary, with_bar)
 from report_data import Results, Run, dig, num, text
 
 
@@ -103,9 +104,10 @@ def _instrumentation(page: Page) -> str:
 def counts_html(page: Page) -> str:
     res = page.results
     parts = []
-    for status in ("ok", "nonfinite", "unsupported"):
+    for status in ("ok", "nonfinite", "unsupported", "invalid"):
         n = sum(1 for r in res.runs if r.status == status)
-        parts.append(f"{status_badge(status)} {n}")
+        if n or status != "invalid":  # invalid only when there are any
+            parts.append(f"{status_badge(status)} {n}")
     if res.unreadable:
         parts.append(f'{status_badge("unreadable")} {len(res.unreadable)}')
     totals = [num(e.get("runs_total")) for e in res.experiments]
@@ -176,6 +178,8 @@ def _status_cell(run: Run) -> tuple[str, object]:
     shown = status_badge(run.status)
     if run.reason:
         shown += f'<div class="reason">{esc(run.reason)}</div>'
+    if run.status == "invalid":
+        shown += f'<div class="reason">{validation_summary(run)}</div>'
     return shown, run.status
 
 
@@ -213,7 +217,8 @@ def run_columns(page: Page) -> list[Column]:
                lambda r: (swatch(r.technique, page), r.technique), False, ""),
         Column("params", "parameters", "technique parameters (swept ones in bold)",
                lambda r: (params_html(r), params_text(r)), False, "params"),
-        Column("status", "status", "ok / nonfinite / unsupported (with the reason)",
+        Column("status", "status", "ok / nonfinite / unsupported (with the reason) / invalid "
+               "(Vulkan validation reported errors or warnings: numbers not trusted, not ranked)",
                _status_cell, False, "reason"),
         Column("frame", "frame [ms]", "median frame time over the timed frames ± IQR "
                "(GPU: sum of pass timestamps)", _frame_cell),
@@ -291,7 +296,8 @@ def run_table_html(page: Page) -> str:
             sort = "" if value is None else (repr(float(value)) if c.numeric and
                                              num(value) is not None else esc(value))
             cells.append(f'<td class="c-{c.id} {c.css}" data-v="{sort}">{shown}</td>')
-        css = "run-row" + (" noise" if run.final.within_reference_noise else "")
+        css = "run-row" + (" noise" if run.final.within_reference_noise else "") + (
+            " invalid" if run.status == "invalid" else "")
         rows.append(f'<tr class="{css}" data-key="{esc(run.key)}">{"".join(cells)}</tr>')
     return ('<h2 id="runs">All runs</h2><p>Every finished run. Click a column header to sort '
             '(click again to reverse); hover a header for its definition. Rows shaded green '
@@ -303,22 +309,46 @@ def run_table_html(page: Page) -> str:
             f'{head}</tr></thead><tbody>{"".join(rows)}</tbody></table></div>')
 
 
+def _run_title(run: Run, page: Page) -> str:
+    """'technique on scene (swept parameters)' for lists of runs."""
+    return (f"{swatch(run.technique, page)} on {esc(run.scene)} "
+            f"({esc(params_text(run, True)) or 'no swept parameter'})")
+
+
+def invalid_banner_html(page: Page) -> str:
+    """A warning at the top of the page listing every invalid run and its first message."""
+    invalid = [r for r in page.results.runs if r.status == "invalid"]
+    if not invalid:
+        return ""
+    items = "".join(f"<li>{status_badge(r.status)} {_run_title(r, page)}: "
+                    f"{validation_summary(r) or 'validation messages'}"
+                    f"{'<br>' + first_message_html(r) if r.first_validation_message() else ''}"
+                    "</li>" for r in invalid)
+    return (f'<div class="warn invalid" id="invalid"><b>{len(invalid)} invalid run'
+            f'{"s" if len(invalid) != 1 else ""}</b>: Vulkan validation reported errors or '
+            'warnings while they ran, so their images and numbers are not trusted. They are '
+            'listed in the run table but left out of the images, figures, Pareto fronts and '
+            'comparisons; a later <code>gilab run</code> redoes them. First message of each '
+            f'(all of them are in its <code>result.json</code>):<ul>{items}</ul></div>')
+
+
 def failures_html(page: Page) -> str:
-    bad = [r for r in page.results.runs if r.status in ("unsupported", "nonfinite")]
+    bad = [r for r in page.results.runs if r.status in ("unsupported", "nonfinite", "invalid")]
     if not bad:
         return ""
     items = []
     for run in bad:
         if run.status == "unsupported":
             why = esc(run.reason) or "no reason recorded"
+        elif run.status == "invalid":
+            why = (validation_summary(run) or "validation messages") + \
+                " (see the warning at the top)"
         else:
             count = nonfinite_count(run)
             why = (f"{int(count)} NaN/Inf pixels in the final image" if count
                    else "non-finite values in an output layer") + \
                 "; its metrics cover the finite pixels only"
-        items.append(f"<li>{status_badge(run.status)} {swatch(run.technique, page)} on "
-                     f"{esc(run.scene)} ({esc(params_text(run, True)) or 'no swept parameter'})"
-                     f": {why}</li>")
+        items.append(f"<li>{status_badge(run.status)} {_run_title(run, page)}: {why}</li>")
     return ('<h3 id="failures">Where techniques break</h3><ul>' + "".join(items) + "</ul>")
 
 

@@ -25,8 +25,8 @@ struct ConeQuery {
     vec4 dirMode;        // xyz direction, w mode
     ConeTraceParams params;
 };
-layout(set = 0, binding = 7, std430) readonly buffer Queries { ConeQuery queries[]; };
-layout(set = 0, binding = 8, std430) writeonly buffer Results { vec4 results[]; };
+layout(set = 0, binding = 9, std430) readonly buffer Queries { ConeQuery queries[]; };
+layout(set = 0, binding = 10, std430) writeonly buffer Results { vec4 results[]; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;

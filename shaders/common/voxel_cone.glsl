@@ -3,7 +3,12 @@
 //     vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir);
 // returning premultiplied radiance (rgb) and opacity (a) at level `lod` (0 = finest voxel size v0,
 // fractional = linear between levels) for a cone travelling along unit `dir`.
-// The caller offsets the origin along the surface normal (about 1-2 v0) to avoid self-occlusion.
+//
+// Level mapping (Crassin §5: "the level corresponding to the cone radius"): the sampled voxel
+// size equals the cone radius r(t) = t tan(theta/2), L = log2(r / v0) + bias, clamped to >= 0.
+// Lift (docs/voxel_cone_tracing.md "Self-gather"): a cone leaving a surface (point x, normal n)
+// keeps each sample at least h(L) = lift v0 2^ceil(L) above the tangent plane (lifting it along
+// n), so the coarse cell holding the surface never enters the sample's quadrilinear footprint.
 #ifndef GILAB_VOXEL_CONE_GLSL
 #define GILAB_VOXEL_CONE_GLSL
 
@@ -18,18 +23,20 @@ struct ConeTraceParams {
     vec4 gridMaxStep;  // xyz grid maximum corner, w = step factor (d' = step * diameter, E10)
     vec4 distances;    // x max distance (world), y start offset t0 (world), z opacity cutoff,
                        // w AO lambda (1/world units)
-    vec4 misc;         // x lod bias (added to coneLod), yzw reserved
+    vec4 misc;         // x lod bias (added to the radius level), y lift factor (0 = no lift),
+                       // zw reserved
 };
 
-// Cone diameter at distance t (notes 003 E6), never below the finest voxel size.
+// Cone diameter at distance t (notes 003 E6).
 float coneDiameter(float t, float tanHalf) {
     return max(2.0 * max(t, 0.0) * max(tanHalf, 0.0), 0.0);
 }
 
-// Level whose voxel size matches the diameter (E7); 0 = finest. Safe for d = 0 and v0 = 0.
+// Level whose voxel size matches the cone radius diameter / 2 (Crassin §5); 0 = finest.
+// Safe for d = 0 and v0 = 0.
 float coneLod(float diameter, float v0) {
     if (!(diameter > 0.0) || !(v0 > 0.0)) return 0.0;
-    return max(0.0, log2(diameter / v0));
+    return max(0.0, log2(0.5 * diameter / v0));
 }
 
 // Deterministic tangent frame around n (unit; a zero n falls back to +z).
@@ -46,39 +53,85 @@ bool coneInsideGrid(vec3 p, ConeTraceParams prm) {
     return all(greaterThanEqual(p, prm.gridMinV0.xyz)) && all(lessThanEqual(p, prm.gridMaxStep.xyz));
 }
 
+// Distance from p (inside the grid) along unit n to the grid's boundary (0.99 of it).
+float coneExitDistance(vec3 p, vec3 n, ConeTraceParams prm) {
+    vec3 lo = (prm.gridMinV0.xyz - p) / n, hi = (prm.gridMaxStep.xyz - p) / n;
+    vec3 far = max(lo, hi);  // +inf on axes n does not move along
+    return 0.99 * max(min(min(far.x, far.y), far.z), 0.0);
+}
+
 // Opacity correction for a step of `ratio` times the level's voxel size (notes 001 §2.9):
 // a' = 1 - (1 - a)^ratio. Returns the corrected premultiplied sample; a = 0 gives vec4(0).
 vec4 coneCorrectSample(vec4 s, float ratio) {
     float a = clamp(s.a, 0.0, 1.0);
     if (!(a > 1e-6)) return vec4(0.0);
-    float corrected = a >= 1.0 ? 1.0 : 1.0 - pow(1.0 - a, ratio);
+    float corrected = a >= 1.0 ? 1.0 : 1.0 - exp2(ratio * log2(1.0 - a));
     vec3 c = max(s.rgb, vec3(0.0)) * (corrected / a);
     return vec4(c, corrected);
 }
 
-// One cone march. Returns rgb = gathered radiance (premultiplied front-to-back sum,
-// C += (1 - A) c', A += (1 - A) a', notes 001 §8 choice), a = accumulated opacity.
-// Stops at A >= cutoff, t > max distance, outside the grid or after VOXEL_CONE_MAX_STEPS.
-vec4 traceCone(vec3 origin, vec3 dir, float tanHalf, ConeTraceParams p) {
+// The surface a cone leaves: point x and unit normal n; n = 0 disables the lift.
+struct ConeSurface {
+    vec3 point;
+    vec3 normal;
+};
+
+ConeSurface coneNoSurface() { return ConeSurface(vec3(0.0), vec3(0.0)); }
+
+#define CONE_MODE_RADIANCE 0
+#define CONE_MODE_OCCLUSION 1
+
+// The one cone march every caller shares. mode RADIANCE: rgb = gathered radiance (premultiplied
+// front-to-back sum C += (1 - A) c', A += (1 - A) a', notes 001 §8 choice), a = opacity.
+// mode OCCLUSION: a = accumulated occlusion of the falloff-weighted opacity f(t) a with
+// f = 1 / (1 + lambda t) (Crassin §6; the step correction applies to f a, so the result does
+// not depend on the step factor), rgb = 0. Stops at the cutoff, t > maxDistance, outside the grid
+// or after VOXEL_CONE_MAX_STEPS.
+vec4 coneMarch(vec3 origin, vec3 dir, float tanHalf, ConeSurface surface, float maxDistance,
+               int mode, ConeTraceParams p) {
     float len = length(dir);
-    if (!(len > 1e-8)) return vec4(0.0);
-    dir /= len;
     float v0 = p.gridMinV0.w;
-    if (!(v0 > 0.0)) return vec4(0.0);
+    if (!(len > 1e-8) || !(v0 > 0.0)) return vec4(0.0);
+    dir /= len;
+    tanHalf = max(tanHalf, 0.0);
     float stepFactor = max(p.gridMaxStep.w, 0.01);
     float cutoff = p.distances.z > 0.0 ? p.distances.z : 1.0;
+    float lambda = mode == CONE_MODE_OCCLUSION ? max(p.distances.w, 0.0) : 0.0;
+    float bias = p.misc.x;
+    float liftFactor = max(p.misc.y, 0.0) * v0;
+    bool lift = liftFactor > 0.0 && dot(surface.normal, surface.normal) > 0.25;
     vec3 color = vec3(0.0);
     float alpha = 0.0;
     float t = max(p.distances.y, 0.0);
     for (int i = 0; i < VOXEL_CONE_MAX_STEPS; ++i) {
-        if (t > p.distances.x || alpha >= cutoff) break;
+        if (t > maxDistance || alpha >= cutoff) break;
+        float d = max(2.0 * t * tanHalf, v0);
+        float lod = max(log2(0.5 * d / v0) + bias, 0.0);
+        float level = exp2(lod);  // sampled voxel size / v0
         vec3 pos = origin + t * dir;
-        if (!coneInsideGrid(pos, p)) break;
-        float d = max(coneDiameter(t, tanHalf), v0);
-        float lod = max(coneLod(d, v0) + p.misc.x, 0.0);
+        if (!coneInsideGrid(pos, p)) break;  // the axis left the grid: nothing more to gather
+        if (lift) {
+            // Notes 001 §2.9: the cell of size v0 2^ceil(L) holding the surface stays out of
+            // the trilinear footprint when the sample is >= 1.5 cells above the plane.
+            float h = dot(pos - surface.point, surface.normal);
+            float need = liftFactor * exp2(ceil(lod)) - h;
+            if (need > 0.0) {
+                // Where the grid ends closer than that along n (an open side of the scene),
+                // sample the coarsest level whose lift stays inside instead of empty space.
+                float room = coneExitDistance(pos, surface.normal, p);
+                if (need > room) {
+                    lod = min(lod, max(floor(log2(max(h + room, 1e-30) / liftFactor)), 0.0));
+                    level = exp2(lod);
+                    need = min(liftFactor * exp2(ceil(lod)) - h, room);
+                }
+                pos += max(need, 0.0) * surface.normal;
+            }
+        }
         float stepLen = stepFactor * d;
+        vec4 s = voxelConeSample(pos, lod, dir);
+        if (mode == CONE_MODE_OCCLUSION) s = vec4(0.0, 0.0, 0.0, s.a / (1.0 + lambda * t));
         // d'/d: the step against the voxel size of the sampled level.
-        vec4 s = coneCorrectSample(voxelConeSample(pos, lod, dir), stepLen / (v0 * exp2(lod)));
+        s = coneCorrectSample(s, stepLen / (v0 * level));
         color += (1.0 - alpha) * s.rgb;
         alpha += (1.0 - alpha) * s.a;
         t += stepLen;
@@ -86,38 +139,33 @@ vec4 traceCone(vec3 origin, vec3 dir, float tanHalf, ConeTraceParams p) {
     return vec4(color, clamp(alpha, 0.0, 1.0));
 }
 
+// A cone from a free point (no surface, no lift): radiance and opacity.
+vec4 traceCone(vec3 origin, vec3 dir, float tanHalf, ConeTraceParams p) {
+    return coneMarch(origin, dir, tanHalf, coneNoSurface(), p.distances.x, CONE_MODE_RADIANCE, p);
+}
+
+// A cone leaving a surface: the origin is offset along n by `offset` (world), samples are lifted.
+vec4 traceSurfaceCone(ConeSurface s, float offset, vec3 dir, float tanHalf, ConeTraceParams p) {
+    return coneMarch(s.point + offset * s.normal, dir, tanHalf, s, p.distances.x,
+                     CONE_MODE_RADIANCE, p);
+}
+
 // Ambient-occlusion visibility 1 - delta of one cone (Crassin §6, notes 001 §2.12, notes 003
-// E11-E12): delta += (1 - delta) a_f', where a_f = f(r) a with f(r) = 1 / (1 + lambda r), r the
-// distance along the cone (Crassin's definition; DVS's r = cone radius t tan(theta/2) is the same
-// with lambda = lambda_DVS tan(theta/2)), and ' the step correction applied to a_f (E12 applies f after
-// the correction, which makes thick occluders depend on the step factor). lambda = 0 gives
-// plain occlusion.
+// E11-E12): delta += (1 - delta) a_f', a_f = f(r) a, f(r) = 1 / (1 + lambda r), r the distance
+// along the cone (Crassin's definition; DVS's r = cone radius is the same with lambda = lambda_DVS
+// tan(theta/2)), ' the step correction applied to a_f. lambda = 0 gives plain occlusion.
 float traceConeOcclusion(vec3 origin, vec3 dir, float tanHalf, ConeTraceParams p) {
-    float len = length(dir);
-    if (!(len > 1e-8)) return 1.0;
-    dir /= len;
-    float v0 = p.gridMinV0.w;
-    if (!(v0 > 0.0)) return 1.0;
-    float stepFactor = max(p.gridMaxStep.w, 0.01);
-    float cutoff = p.distances.z > 0.0 ? p.distances.z : 1.0;
-    float lambda = max(p.distances.w, 0.0);
-    float delta = 0.0;
-    float t = max(p.distances.y, 0.0);
-    for (int i = 0; i < VOXEL_CONE_MAX_STEPS; ++i) {
-        if (t > p.distances.x || delta >= cutoff) break;
-        vec3 pos = origin + t * dir;
-        if (!coneInsideGrid(pos, p)) break;
-        float d = max(coneDiameter(t, tanHalf), v0);
-        float lod = max(coneLod(d, v0) + p.misc.x, 0.0);
-        float stepLen = stepFactor * d;
-        // The falloff scales the opacity field (Crassin: alpha_f = f(r) alpha), and the step
-        // correction applies to that field, so the result does not depend on the step factor.
-        float a = clamp(voxelConeSample(pos, lod, dir).a, 0.0, 1.0) / (1.0 + lambda * t);
-        a = coneCorrectSample(vec4(0.0, 0.0, 0.0, a), stepLen / (v0 * exp2(lod))).a;
-        delta += (1.0 - delta) * a;
-        t += stepLen;
-    }
-    return clamp(1.0 - delta, 0.0, 1.0);
+    if (!(length(dir) > 1e-8) || !(p.gridMinV0.w > 0.0)) return 1.0;
+    return 1.0 - coneMarch(origin, dir, tanHalf, coneNoSurface(), p.distances.x,
+                           CONE_MODE_OCCLUSION, p).a;
+}
+
+// Occlusion visibility of a cone leaving a surface, up to maxDistance (AO, soft shadows).
+float traceSurfaceConeVisibility(ConeSurface s, float offset, vec3 dir, float tanHalf,
+                                 float maxDistance, ConeTraceParams p) {
+    if (!(length(dir) > 1e-8) || !(p.gridMinV0.w > 0.0)) return 1.0;
+    return 1.0 - coneMarch(s.point + offset * s.normal, dir, tanHalf, s, maxDistance,
+                           CONE_MODE_OCCLUSION, p).a;
 }
 
 #endif  // GILAB_VOXEL_CONE_GLSL

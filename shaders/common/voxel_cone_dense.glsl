@@ -1,5 +1,6 @@
 // voxelConeSample for gilab::VoxelRadiance (dense N^3 base + 6 directional (N/2)^3 volumes with
-// mips; docs/voxel_cone_tracing.md, notes 003 §2.8 and §7.1). Before including, define
+// mips, stacked in one atlas; docs/voxel_cone_tracing.md, notes 003 §2.8 and §7.1). Before
+// including, define
 //     #define VOXEL_CONE_SET <set>
 //     #define VOXEL_CONE_BINDING <first binding>   (layout as VoxelRadiance::addLayoutBindings)
 //     VoxelGridInfo voxelConeGrid();               (shaders/common/voxel_grid.glsl)
@@ -8,8 +9,10 @@
 // lod < 1 then reads directional level 0).
 // Then this file provides voxelConeSample and includes voxel_cone.glsl (traceCone, ...).
 // Level mapping: lod < 1 mixes base and directional level 0 by lod; lod >= 1 reads directional
-// level lod - 1 (hardware linear between mips). Directional sample = sum over axes of dir^2 times
-// the face for rays travelling along dir (dir.x < 0 -> -X face = index 0).
+// level lod - 1 (hardware linear between mips). Branch-free: lavapipe executes both sides of a
+// branch, so every sample reads the directional level max(lod - 1, 0) and the base.
+// Directional sample = sum over axes of dir^2 times the face for rays travelling along dir
+// (dir.x < 0 -> -X face = index 0).
 #ifndef GILAB_VOXEL_CONE_DENSE_GLSL
 #define GILAB_VOXEL_CONE_DENSE_GLSL
 
@@ -20,26 +23,34 @@
 #endif
 
 layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING) uniform sampler3D voxelConeBase;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 1) uniform sampler3D voxelConeNegX;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 2) uniform sampler3D voxelConePosX;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 3) uniform sampler3D voxelConeNegY;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 4) uniform sampler3D voxelConePosY;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 5) uniform sampler3D voxelConeNegZ;
-layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 6) uniform sampler3D voxelConePosZ;
+layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 1) uniform sampler3D voxelConeFaces;
+layout(set = VOXEL_CONE_SET, binding = VOXEL_CONE_BINDING + 2) uniform sampler3D voxelConeNormals;
 
-// Directional (or isotropic) filtered volume at filtered level `level` (0 = (N/2)^3).
+#include "common/voxel_facing.glsl"
+
+// One slab of the filtered atlas (6 faces -X,+X,-Y,+Y,-Z,+Z stacked in z, or 1 isotropic) at
+// filtered level `level`. z is clamped half a texel of the coarser level inside the slab, so
+// the hardware filter never mixes two faces (z is clamp-to-edge, x and y clamp-to-border).
+vec4 voxelConeSlab(vec3 uvw, float level, float slab, float slabs) {
+    float n = float(voxelResolution(voxelConeGrid()) / 2u);
+    float halfTexel = 0.5 * exp2(ceil(level)) / n;
+    float z = clamp(uvw.z, min(halfTexel, 0.5), max(1.0 - halfTexel, 0.5));
+    return textureLod(voxelConeFaces, vec3(uvw.xy, (slab + z) / slabs), level);
+}
+
+// Directional (or isotropic) filtered volume at filtered level `level` (0 = (N/2)^3): per axis
+// the face its sign selects (chosen by coordinates: no branch, one fetch per axis), weighted
+// by dir^2.
 vec4 voxelConeDirectional(vec3 uvw, float level, vec3 dir) {
-    if (!voxelConeAnisotropic()) return textureLod(voxelConeNegX, uvw, level);
+    if (!voxelConeAnisotropic()) return voxelConeSlab(uvw, level, 0.0, 1.0);
     vec3 w = dir * dir;
-    vec4 sx = dir.x < 0.0 ? textureLod(voxelConeNegX, uvw, level)
-                          : textureLod(voxelConePosX, uvw, level);
-    vec4 sy = dir.y < 0.0 ? textureLod(voxelConeNegY, uvw, level)
-                          : textureLod(voxelConePosY, uvw, level);
-    vec4 sz = dir.z < 0.0 ? textureLod(voxelConeNegZ, uvw, level)
-                          : textureLod(voxelConePosZ, uvw, level);
     float wsum = w.x + w.y + w.z;
     if (!(wsum > 1e-12)) return vec4(0.0);
-    return (w.x * sx + w.y * sy + w.z * sz) / wsum;
+    vec3 face = vec3(0.0, 2.0, 4.0) + step(vec3(0.0), dir);  // dir < 0: -axis face
+    vec4 s = w.x * voxelConeSlab(uvw, level, face.x, 6.0);
+    s += w.y * voxelConeSlab(uvw, level, face.y, 6.0);
+    s += w.z * voxelConeSlab(uvw, level, face.z, 6.0);
+    return s / wsum;
 }
 
 vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
@@ -52,12 +63,11 @@ vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
     // read it; lod < 1 takes directional level 0.
     s = voxelConeDirectional(uvw, max(lod - 1.0, 0.0), dir);
 #else
-    if (lod < 1.0) {
-        vec4 base = textureLod(voxelConeBase, uvw, 0.0);
-        s = lod > 0.0 ? mix(base, voxelConeDirectional(uvw, 0.0, dir), lod) : base;
-    } else {
-        s = voxelConeDirectional(uvw, lod - 1.0, dir);
-    }
+    // Shade the base toward the cone (the directional levels are built facing-weighted)
+    vec4 base = textureLod(voxelConeBase, uvw, 0.0);
+    base.rgb *= voxelFacing(textureLod(voxelConeNormals, uvw, 0.0), dir);
+    vec4 directional = voxelConeDirectional(uvw, max(lod - 1.0, 0.0), dir);
+    s = mix(base, directional, clamp(lod, 0.0, 1.0));
 #endif
     // Empty samples carry no colour; no negative or non-finite values leave here.
     s = max(s, vec4(0.0));

@@ -50,27 +50,6 @@ float specularTanHalf(float roughness) {
     return tan(halfAngle);
 }
 
-// Soft-shadow cone toward a light (notes 003 §4.3, E13 with k = 1): accumulate only opacity,
-// alpha += (1 - alpha) a'; visibility = 1 - alpha. Stops at maxDist (the light) or the cutoff.
-float coneShadow(vec3 origin, vec3 dir, float tanHalf, float maxDist, ConeTraceParams p) {
-    float v0 = p.gridMinV0.w;
-    float stepFactor = max(p.gridMaxStep.w, 0.01);
-    float alpha = 0.0;
-    float t = max(p.distances.y, 0.0);
-    for (int i = 0; i < VOXEL_CONE_MAX_STEPS; ++i) {
-        if (t > maxDist || alpha >= p.distances.z) break;
-        vec3 pos = origin + t * dir;
-        if (!coneInsideGrid(pos, p)) break;
-        float d = max(coneDiameter(t, tanHalf), v0);
-        float lod = max(coneLod(d, v0) + p.misc.x, 0.0);
-        float stepLen = stepFactor * d;
-        float a = coneCorrectSample(voxelConeSample(pos, lod, dir), stepLen / (v0 * exp2(lod))).a;
-        alpha += (1.0 - alpha) * a;
-        t += stepLen;
-    }
-    return 1.0 - clamp(alpha, 0.0, 1.0);
-}
-
 void main() {
     ivec2 pixel = ivec2(gl_GlobalInvocationID.xy);
     if (pixel.x >= int(u.size.x) || pixel.y >= int(u.size.y)) return;
@@ -87,7 +66,8 @@ void main() {
     vec3 wo = normalize(u.camera.xyz - x);
     ConeTraceParams p = ConeTraceParams(u.coneParams[0], u.coneParams[1], u.coneParams[2],
                                         u.coneParams[3]);
-    vec3 origin = x + n * u.camera.w;
+    ConeSurface surface = ConeSurface(x, n);  // cones leave (x, n): offset + lift
+    float offset = u.camera.w;
 
     // Diffuse cones (E14) and AO (E11-E12) over the same set.
     vec3 diffuseAlbedo = albedo * (1.0 - metalRough.x);
@@ -100,11 +80,12 @@ void main() {
     for (uint i = 0u; i < coneSetCount(u.diffuse); ++i) {
         vec3 dir = coneToWorld(coneSetDirection(u.diffuse, i), n);
         float w = coneSetWeight(u.diffuse, i);
-        if (wantDiffuse) gathered += w * traceCone(origin, dir, tanHalf, p).rgb;
+        if (wantDiffuse) gathered += w * traceSurfaceCone(surface, offset, dir, tanHalf, p).rgb;
         if (wantAo) {
             ConeTraceParams pa = p;
             pa.distances.w = u.shadow.y;
-            visibility += w * traceConeOcclusion(origin, dir, tanHalf, pa);
+            visibility +=
+                w * traceSurfaceConeVisibility(surface, offset, dir, tanHalf, pa.distances.x, pa);
         }
         weightSum += w;
     }
@@ -116,7 +97,7 @@ void main() {
         vec3 r = reflect(-wo, n);
         float tanSpec = u.specular.y > 0.0 ? u.specular.y : specularTanHalf(metalRough.y);
         vec3 f0 = mix(vec3(0.04), albedo, metalRough.x);
-        indirect += f0 * traceCone(origin, r, tanSpec, p).rgb;
+        indirect += f0 * traceSurfaceCone(surface, offset, r, tanSpec, p).rgb;
     }
 
     // Direct light with cone shadows (replaces the shared direct layer).
@@ -135,7 +116,9 @@ void main() {
                 float maxDist = uint(light.positionType.w) == PASS_LIGHT_DIRECTIONAL
                                     ? p.distances.x
                                     : dist - p.gridMinV0.w;
-                float vis = coneShadow(origin, wi, u.shadow.x, maxDist, p);
+                // Soft-shadow cone toward the light (notes 003 §4.3, E13 with k = 1): opacity
+                // only, up to the light; the shared march (lambda = 0 in p).
+                float vis = traceSurfaceConeVisibility(surface, offset, wi, u.shadow.x, maxDist, p);
                 if (vis <= 0.0) continue;
                 vec3 f = evalBrdf(n, wi, wo, albedo, metalRough.x, metalRough.y);
                 direct += f * ePerp * (cosTheta * vis);

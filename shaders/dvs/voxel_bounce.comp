@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // DVS pass G1, per-voxel first bounce (notes 003 §2.6), one thread per voxel: diffuse cones
-// around the voxel's averaged normal through the filtered direct radiance, then
+// around the voxel's averaged normal through the filtered direct radiance (the pixel cones'
+// step, level mapping and lift), then
 //   out.rgb = base.rgb + a * (rho / pi) * sum_i w_i L_i   (sum w = pi, E14; HDR, no clamp)
 //   out.a   = base.a
 // written to a scratch volume (copied over the base afterwards), so the cones may read every
@@ -19,7 +20,7 @@ layout(set = 0, binding = 2, rgba16f) uniform writeonly image3D outRadiance;
 layout(set = 0, binding = 3, std140) uniform BounceUniforms {
     VoxelGridInfo grid;
     vec4 coneParams[4];  // ConeTraceParams
-    vec4 misc;           // x origin offset along the normal (world)
+    vec4 misc;           // x origin offset along the normal (world) from the lift plane
     ConeSetData cones;
 } u;
 
@@ -43,12 +44,15 @@ void main() {
     vec3 n = nl.xyz / nLen;
     ConeTraceParams p = ConeTraceParams(u.coneParams[0], u.coneParams[1], u.coneParams[2],
                                         u.coneParams[3]);
-    vec3 origin = voxelCenterWorld(u.grid, c) + n * u.misc.x;
+    // The voxel's surface lies within half a voxel of its centre along n: the lift plane goes
+    // through the top of that range, so the voxel's own cells stay out of every sample.
+    float v0 = voxelSize(u.grid);
+    ConeSurface surface = ConeSurface(voxelCenterWorld(u.grid, c) + 0.5 * v0 * n, n);
     float tanHalf = coneSetTanHalf(u.cones);
     vec3 gathered = vec3(0.0);
     for (uint i = 0u; i < coneSetCount(u.cones); ++i) {
         vec3 dir = coneToWorld(coneSetDirection(u.cones, i), n);
-        gathered += coneSetWeight(u.cones, i) * traceCone(origin, dir, tanHalf, p).rgb;
+        gathered += coneSetWeight(u.cones, i) * traceSurfaceCone(surface, u.misc.x, dir, tanHalf, p).rgb;
     }
     vec3 bounce = albedo.a * albedo.rgb * (1.0 / DVS_PI) * gathered;
     imageStore(outRadiance, c, vec4(direct.rgb + bounce, direct.a));

@@ -56,7 +56,9 @@ void main() {
     vec3 albedo = imageLoad(gAlbedo, pixel).rgb;
     vec2 metalRough = imageLoad(gMaterial, pixel).xy;
     ConeTraceParams p = gatherConeParams();
-    vec3 origin = position.xyz + n * gather.specular.z;
+    // Cones leave the surface (x, n): origin offset along n, samples lifted (voxel_cone.glsl)
+    ConeSurface surface = ConeSurface(position.xyz, n);
+    float offset = gather.specular.z;
 
     // Diffuse cones (and AO with the same set)
     uint count = min(uint(gather.coneInfo.x + 0.5), 16u);
@@ -66,8 +68,11 @@ void main() {
     for (uint i = 0u; i < count; ++i) {
         vec3 dir = coneToWorld(gather.cones[i].xyz, n);
         float w = gather.cones[i].w;
-        diffuse += w * traceCone(origin, dir, tanHalf, p).rgb;
-        if ((flags & GATHER_FLAG_AO) != 0u) visibility += w * traceConeOcclusion(origin, dir, tanHalf, p);
+        diffuse += w * traceSurfaceCone(surface, offset, dir, tanHalf, p).rgb;
+        if ((flags & GATHER_FLAG_AO) != 0u) {
+            visibility +=
+                w * traceSurfaceConeVisibility(surface, offset, dir, tanHalf, p.distances.x, p);
+        }
     }
     vec3 indirect = albedo * (1.0 - metalRough.x) * (1.0 / BRDF_PI) * diffuse;
 
@@ -79,7 +84,7 @@ void main() {
             vec3 r = reflect(-toEye / eyeLen, n);
             float aperture = specularAperture(metalRough.y);
             vec3 f0 = mix(vec3(0.04), albedo, metalRough.x);
-            indirect += f0 * traceCone(origin, r, tan(0.5 * aperture), p).rgb;
+            indirect += f0 * traceSurfaceCone(surface, offset, r, tan(0.5 * aperture), p).rgb;
         }
     }
     // No NaN / Inf leaves the pass

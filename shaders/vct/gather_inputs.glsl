@@ -27,7 +27,7 @@ layout(set = 0, binding = 6, std140) uniform GatherParams {
     vec4 gridMinV0;    // xyz grid minimum corner, w v0
     vec4 gridMaxStep;  // xyz grid maximum corner, w step factor
     vec4 distances;    // x max distance (world), y t0 (world), z opacity cutoff, w AO lambda
-    vec4 misc;         // x lod bias
+    vec4 misc;         // x lod bias, y lift factor (voxel_cone.glsl)
     // ConeSetData of common/cone_set.glsl
     vec4 cones[16];  // xyz tangent-space direction, w weight (sum = pi)
     vec4 coneInfo;   // x count, y tan(aperture / 2)

@@ -1,5 +1,5 @@
 // Voxel shading after the splat (notes 001 §8, dense recommendation): one thread per voxel,
-//   irradiance E = sum(flux) / v0^2 (the voxel's cross-section),
+//   E = sum over lights of the light's mean photon irradiance in the voxel (splat_dense_body),
 //   base.rgb = a * albedo / pi * E (outgoing diffuse radiance premultiplied by coverage a),
 //   base.a = a.
 // The paper stores incoming radiance and shades toward each cone at trace time (§7); voxels are
@@ -16,15 +16,15 @@ void main() {
     if (!voxelInside(pc.grid, c)) return;
     uint index = voxelLinearIndex(pc.grid, c);
 #ifdef INJECT_FIXED_POINT
-    vec3 flux = vec3(fluxPlanes[0].v[index], fluxPlanes[1].v[index], fluxPlanes[2].v[index]) *
-                pc.scale.y;
+    vec3 irradiance = vec3(irradiancePlanes[0].v[index], irradiancePlanes[1].v[index],
+                           irradiancePlanes[2].v[index]) * pc.scale.w;
 #else
-    vec3 flux = vec3(fluxPlanes[0].v[index], fluxPlanes[1].v[index], fluxPlanes[2].v[index]);
+    vec3 irradiance = vec3(irradiancePlanes[0].v[index], irradiancePlanes[1].v[index],
+                           irradiancePlanes[2].v[index]);
 #endif
     vec4 albedoOpacity = texelFetch(voxelAlbedoOpacity, c, 0);
     float a = clamp(albedoOpacity.a, 0.0, 1.0);
-    float v0 = voxelSize(pc.grid);
-    vec3 radiance = a * albedoOpacity.rgb * (1.0 / 3.14159265358979) * flux / max(v0 * v0, 1e-30);
+    vec3 radiance = a * albedoOpacity.rgb * (1.0 / 3.14159265358979) * max(irradiance, vec3(0.0));
     // RGBA16F saturates at 65504: clamp there rather than store Inf (counted in docs/vct.md)
     imageStore(radianceBase, c, vec4(min(radiance, vec3(65504.0)), a));
 }

@@ -37,11 +37,28 @@ layout(set = 0, binding = 6, rgba16f) uniform image3D svoGeometry;
 #define SVO_INFO svo
 #include "vct/svo_tree.glsl"
 
-// x depth, y axis (0..2), z pass / sub-mode, w target (0 accumulators, 1 radiance, 2 geometry)
+// Work-group size of every octree pass (SparseVoxelOctree::kGroupSize).
+#define SVO_GROUP_SIZE 64
+
+// Targets: 0 flux accumulators (by brick), 1 radiance (isotropic brick at the radiance slot),
+// 2 geometry (by brick), 3 directional radiance (6 bricks at slot + face).
+#define SVO_TARGET_ACCUM 0u
+#define SVO_TARGET_RADIANCE 1u
+#define SVO_TARGET_GEOMETRY 2u
+#define SVO_TARGET_DIRECTIONAL 3u
+
+// x depth, y axis (0..2), z pass / sub-mode, w target (SVO_TARGET_*)
 layout(push_constant, std430) uniform SvoPush {
     uvec4 args;
     vec4 scale;  // x fixed-point units per W, y W per unit, z 1 / (pi v0^2)
 } pc;
+
+// Linear thread index of a 1D launch recorded as a 2D grid (SparseVoxelOctree::dispatchGroups:
+// x groups per row, y rows) so that no dimension exceeds maxComputeWorkGroupCount.
+uint svoThread() {
+    uint row = gl_NumWorkGroups.x * SVO_GROUP_SIZE;
+    return gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * row;
+}
 
 uint svoLevelBegin(uint depth) { return svoCounters[4u + 2u * depth]; }
 uint svoLevelEnd(uint depth) { return svoCounters[5u + 2u * depth]; }
@@ -53,6 +70,17 @@ bool svoOccupied(uint depth, uvec3 c) {
 }
 
 int svoSampleIndex(ivec3 s) { return s.x + 3 * (s.y + 3 * s.z); }
+
+// Node word holding the brick index of `target`: the geometry brick (also indexes the flux
+// accumulators) or the radiance slot.
+uint svoTargetWord(uint target) {
+    return (target == SVO_TARGET_GEOMETRY || target == SVO_TARGET_ACCUM) ? SVO_W_BRICK
+                                                                        : SVO_W_RADIANCE;
+}
+// First texel of brick `index` of the image of `target` (not the accumulators).
+ivec3 svoTargetOrigin(uint target, uint index) {
+    return target == SVO_TARGET_GEOMETRY ? svoBrickOrigin(index) : svoRadianceOrigin(index);
+}
 
 vec4 svoLoad(uint target, ivec3 texel) {
     return target == 2u ? imageLoad(svoGeometry, texel) : imageLoad(svoRadiance, texel);

@@ -6,10 +6,12 @@
 // its own children (child coordinates 0..4); a child sample on the parent's boundary (coordinate 0
 // or 4) is shared with the neighbouring parent and is weighted by 1/2 per such axis (inverse
 // multiplicity), so the svo_transfer add/copy passes that follow complete the sums exactly.
-// One thread per (node of depth d, sample). pc.args: x parent depth d, w target image.
+// One thread per (node of depth d, sample). pc.args: x parent depth d, w target image
+// (SVO_TARGET_RADIANCE: isotropic radiance bricks at the radiance slots, SVO_TARGET_GEOMETRY).
+// The anisotropic radiance filter is svo_filter_aniso.comp.
 #include "vct/svo_common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 float axisWeight(int c, int i) {
     int a = c - 2 * i;
@@ -21,10 +23,11 @@ float axisWeight(int c, int i) {
 void main() {
     uint d = pc.args.x;
     uint target = pc.args.w;
-    uint t = gl_GlobalInvocationID.x;
+    uint t = svoThread();
     uint node = svoLevelBegin(d) + t / 27u;
     if (node >= svoLevelEnd(d)) return;
-    uint brick = svoWord(node, SVO_W_BRICK);
+    uint word = svoTargetWord(target);
+    uint brick = svoWord(node, word);
     if (brick == SVO_NONE) return;
     int k = int(t % 27u);
     ivec3 i = ivec3(k % 3, (k / 3) % 3, k / 9);
@@ -36,13 +39,13 @@ void main() {
                 for (int x = max(2 * i.x - 1, 0); x <= min(2 * i.x + 1, 4); ++x) {
                     ivec3 c = ivec3(x, y, z);
                     ivec3 o = min(c >> 1, ivec3(1));  // child 0 holds 0..2, child 1 holds 2..4
-                    uint cb = svoWord(child + uint(o.x + 2 * o.y + 4 * o.z), SVO_W_BRICK);
+                    uint cb = svoWord(child + uint(o.x + 2 * o.y + 4 * o.z), word);
                     if (cb == SVO_NONE) continue;
                     float w = axisWeight(x, i.x) * axisWeight(y, i.y) * axisWeight(z, i.z);
-                    sum += w * svoLoad(target, svoBrickOrigin(cb) + c - 2 * o);
+                    sum += w * svoLoad(target, svoTargetOrigin(target, cb) + c - 2 * o);
                 }
             }
         }
     }
-    svoStore(target, svoBrickOrigin(brick) + i, sum);
+    svoStore(target, svoTargetOrigin(target, brick) + i, sum);
 }

@@ -7,11 +7,11 @@
 #include "vct/svo_common.glsl"
 
 layout(set = 1, binding = 0) uniform sampler3D voxelAlbedoOpacity;
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
     uint d = svo.dims.y;
-    uint t = gl_GlobalInvocationID.x;
+    uint t = svoThread();
     uint node = svoLevelBegin(d) + t / 27u;
     if (node >= svoLevelEnd(d)) return;
     uint brick = svoWord(node, SVO_W_BRICK);

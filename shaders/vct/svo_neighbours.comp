@@ -5,11 +5,11 @@
 // transfer, notes 001 §2.6). SVO_NONE where the neighbour was collapsed or lies outside.
 #include "vct/svo_common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
     uint d = pc.args.x;
-    uint node = svoLevelBegin(d) + gl_GlobalInvocationID.x;
+    uint node = svoLevelBegin(d) + svoThread();
     if (node >= svoLevelEnd(d)) return;
     ivec3 c = ivec3(svoUnpackCoord(svoWord(node, SVO_W_COORD)));
     int n = int(svo.depthInfo[d].y);

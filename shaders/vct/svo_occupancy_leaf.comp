@@ -5,12 +5,12 @@
 #include "vct/svo_common.glsl"
 
 layout(set = 1, binding = 0) uniform sampler3D voxelAlbedoOpacity;
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
     uint d = svo.dims.y;
     uint n = svo.depthInfo[d].y;
-    uint idx = gl_GlobalInvocationID.x;
+    uint idx = svoThread();
     if (idx >= n * n * n) return;
     uvec3 c = uvec3(idx % n, (idx / n) % n, idx / (n * n));
     int res = int(svo.dims.x);

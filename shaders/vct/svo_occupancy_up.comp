@@ -5,12 +5,12 @@
 // those cells (a conservative superset; it keeps "empty parent => empty children").
 #include "vct/svo_common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
     uint d = pc.args.x;
     uint n = svo.depthInfo[d].y;
-    uint idx = gl_GlobalInvocationID.x;
+    uint idx = svoThread();
     if (idx >= n * n * n) return;
     ivec3 m = ivec3(idx % n, (idx / n) % n, idx / (n * n));
     int nc = int(svo.depthInfo[d + 1u].y);

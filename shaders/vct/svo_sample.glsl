@@ -1,9 +1,13 @@
 // voxelConeSample for the sparse voxel octree (techniques/vct/svo.h, docs/vct_svo.md; Crassin
-// §5, notes 001 §2.9): quadrilinear lookup = trilinear inside the vertex-centred brick of the node
-// whose level matches the lod (hardware linear filter on the brick pool: the brick's samples are
-// texel centres, so a position inside the node never leaves its brick), linear between the
-// levels floor(lod) and floor(lod) + 1. Descends from the root each time; stops at a collapsed
-// node (empty space -> vec4(0)). Isotropic: `dir` is unused.
+// §5, §9, notes 001 §2.8-2.9): quadrilinear lookup = trilinear inside the vertex-centred brick of
+// the node whose level matches the lod (hardware linear filter on the brick pool: the brick's
+// samples are texel centres, so a position inside the node never leaves its brick), linear
+// between the levels floor(lod) and floor(lod) + 1. Descends from the root each time; stops at a
+// collapsed node (empty space -> vec4(0)). Level 0 (leaves) is isotropic. Levels >= 1 of an
+// anisotropic octree: per axis the directional brick chosen by the sign of `dir` (dir.x < 0 ->
+// -X, rays travelling toward -x), weighted by dir^2 / |dir|^2, as the dense sampler
+// (voxelConeDirectional in common/voxel_cone_dense.glsl); so lod < 1 blends the isotropic leaf
+// level with the first directional level. Isotropic octree: `dir` is unused.
 // Before including, define SVO_SET and SVO_BINDING (layout as
 // SparseVoxelOctree::addLayoutBindings: +0 SvoInfo uniform, +1 node pool, +2 radiance bricks).
 #ifndef GILAB_VCT_SVO_SAMPLE_GLSL
@@ -27,8 +31,15 @@ layout(set = SVO_SET, binding = SVO_BINDING + 2) uniform sampler3D svoRadiancePo
 #define SVO_INFO svoInfo
 #include "vct/svo_tree.glsl"
 
-// Level l sample (spacing v0 2^l) at grid position g (voxel units, centres at i + 0.5).
-vec4 svoSampleLevel(vec3 g, uint level) {
+// Trilinear lookup at `local` (0..2 per axis) in radiance brick `slot`.
+vec4 svoFetch(uint slot, vec3 local) {
+    vec3 texel = vec3(svoRadianceOrigin(slot)) + 0.5 + local;
+    return textureLod(svoRadiancePool, texel / vec3(textureSize(svoRadiancePool, 0)), 0.0);
+}
+
+// Level l sample (spacing v0 2^l) at grid position g (voxel units, centres at i + 0.5) for a
+// cone travelling along `dir`.
+vec4 svoSampleLevel(vec3 g, uint level, vec3 dir) {
     uint leafDepth = svoInfo.dims.y;
     uint depth = leafDepth - level;
     float n = float(svoInfo.dims.x);
@@ -39,11 +50,17 @@ vec4 svoSampleLevel(vec3 g, uint level) {
     uvec3 cell = min(uvec3(floor(u * 0.5)), uvec3(cells - 1u));
     uint node = svoFindNode(cell, depth);
     if (node == SVO_NONE) return vec4(0.0);
-    uint brick = svoWord(node, SVO_W_BRICK);
-    if (brick == SVO_NONE) return vec4(0.0);
+    uint slot = svoWord(node, SVO_W_RADIANCE);
+    if (slot == SVO_NONE) return vec4(0.0);
     vec3 local = clamp(u - 2.0 * vec3(cell), vec3(0.0), vec3(2.0));
-    vec3 texel = vec3(svoBrickOrigin(brick)) + 0.5 + local;
-    return textureLod(svoRadiancePool, texel / vec3(textureSize(svoRadiancePool, 0)), 0.0);
+    if (level == 0u || !svoAnisotropic()) return svoFetch(slot, local);
+    vec3 w = dir * dir;
+    float wsum = w.x + w.y + w.z;
+    if (!(wsum > 1e-12)) return vec4(0.0);
+    vec4 sx = svoFetch(slot + (dir.x < 0.0 ? 0u : 1u), local);
+    vec4 sy = svoFetch(slot + (dir.y < 0.0 ? 2u : 3u), local);
+    vec4 sz = svoFetch(slot + (dir.z < 0.0 ? 4u : 5u), local);
+    return (w.x * sx + w.y * sy + w.z * sz) / wsum;
 }
 
 vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
@@ -54,8 +71,8 @@ vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
     lod = clamp(lod, 0.0, maxLevel);
     uint l0 = uint(floor(lod));
     float f = lod - float(l0);
-    vec4 s = svoSampleLevel(g, l0);
-    if (f > 0.0 && l0 < svoInfo.dims.y) s = mix(s, svoSampleLevel(g, l0 + 1u), f);
+    vec4 s = svoSampleLevel(g, l0, dir);
+    if (f > 0.0 && l0 < svoInfo.dims.y) s = mix(s, svoSampleLevel(g, l0 + 1u, dir), f);
     s = max(s, vec4(0.0));
     if (!(s.a > 0.0)) return vec4(0.0);
     return vec4(s.rgb, min(s.a, 1.0));

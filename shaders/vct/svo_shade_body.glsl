@@ -1,21 +1,23 @@
 // Leaf shading after the flux transfer (the dense path's formula, spec "Shared data
 // conventions"): rgb = a albedo / pi * sum(flux) / v0^2 (premultiplied outgoing diffuse
-// radiance), a = coverage, from the geometry brick (a albedo, a). One thread per leaf sample.
+// radiance), a = coverage, from the geometry brick (a albedo, a), written to the leaf's radiance
+// slot. One thread per leaf sample.
 #include "vct/svo_common.glsl"
 
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 void main() {
     uint d = svo.dims.y;
-    uint t = gl_GlobalInvocationID.x;
+    uint t = svoThread();
     uint node = svoLevelBegin(d) + t / 27u;
     if (node >= svoLevelEnd(d)) return;
     uint brick = svoWord(node, SVO_W_BRICK);
     if (brick == SVO_NONE) return;
     uint k = t % 27u;
     ivec3 s = ivec3(int(k % 3u), int((k / 3u) % 3u), int(k / 9u));
-    ivec3 texel = svoBrickOrigin(brick) + s;
-    vec4 g = imageLoad(svoGeometry, texel);
+    uint slot = svoWord(node, SVO_W_RADIANCE);
+    if (slot == SVO_NONE) return;
+    vec4 g = imageLoad(svoGeometry, svoBrickOrigin(brick) + s);
     uint base = (brick * 27u + k) * 3u;
 #ifdef SVO_FLOAT_ACCUM
     vec3 flux = vec3(svoAccum[base], svoAccum[base + 1u], svoAccum[base + 2u]);
@@ -24,5 +26,5 @@ void main() {
 #endif
     flux = max(flux, vec3(0.0));
     vec3 rgb = g.a > 0.0 ? g.rgb * flux * pc.scale.z : vec3(0.0);
-    imageStore(svoRadiance, texel, vec4(rgb, g.a));
+    imageStore(svoRadiance, svoRadianceOrigin(slot) + s, vec4(rgb, g.a));
 }

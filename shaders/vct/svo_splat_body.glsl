@@ -9,7 +9,7 @@
 layout(set = 2, binding = 0, std430) readonly buffer Photons {
     Photon photons[];
 };
-layout(local_size_x = 64) in;
+layout(local_size_x = SVO_GROUP_SIZE) in;
 
 // Leaf node and brick holding sample s, or SVO_NONE; brick sample covered (geometry a > 0).
 uint leafBrickOf(ivec3 s, out ivec3 local, out bool covered) {
@@ -27,7 +27,7 @@ uint leafBrickOf(ivec3 s, out ivec3 local, out bool covered) {
 }
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint i = svoThread();
     if (i >= pc.args.x) return;
     Photon p = photons[i];
     if (p.positionValid.w < 0.5) return;

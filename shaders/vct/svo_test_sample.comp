@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
 // Test of the octree cone sampler (tests/vct_svo_test.cpp): one thread per query, writes
-// voxelConeSample(position.xyz, position.w = lod, +z) into `results`. Set 0 = the octree's
+// voxelConeSample(position.xyz, position.w = lod, direction.xyz) into `results` (query i =
+// queries[2i] position + lod, queries[2i + 1] direction). Set 0 = the octree's
 // bindings (SparseVoxelOctree::addLayoutBindings(first = 0)), set 1 = queries and results.
 #define SVO_SET 0
 #define SVO_BINDING 0
@@ -21,5 +22,5 @@ layout(local_size_x = 64) in;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.count) return;
-    results[i] = voxelConeSample(queries[i].xyz, queries[i].w, vec3(0.0, 0.0, 1.0));
+    results[i] = voxelConeSample(queries[2u * i].xyz, queries[2u * i].w, queries[2u * i + 1u].xyz);
 }

@@ -45,6 +45,7 @@ void DvsTechnique::setup(TechniqueContext& ctx) {
     m_voxelizer = std::make_unique<Voxelizer>(ctx.vk, ctx.gpuScene, grid);
     m_radiance =
         std::make_unique<VoxelRadiance>(ctx.vk, grid, VoxelRadianceOptions{}, ctx.tag("radiance"));
+    m_radiance->setSurfaceNormals(m_voxelizer->volumes().normal);  // voxels face their side
     m_lighting = std::make_unique<DvsVoxelLighting>(ctx.vk, *m_voxelizer, *m_radiance,
                                                     ctx.shared.shadows(), s, ctx.tag("lighting"));
     ctx.submitTimed([&](VkCommandBuffer cmd) {

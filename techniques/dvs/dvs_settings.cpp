@@ -48,7 +48,11 @@ std::vector<ParamSpec> dvsParamSpecs() {
         floatParam("step_factor", 0.5, 0.05, 4.0, "", "E10 beta: step = beta x cone diameter"),
         floatParam("max_distance", 0.95, 0.01, 2.0, "grid sides", "cone length limit (repo 0.95)"),
         floatParam("lod_offset", 0.0, -2.0, 2.0, "levels",
-                   "added to E7's level (0 = E7 literally, -1 = repo's one-finer mapping)"),
+                   "added to the cone level log2(radius / v0) (0 = the radius level, one finer "
+                   "than E7's diameter level, as the repo samples; docs/dvs.md)"),
+        floatParam("lift", 1.5, 0.0, 4.0, "cells",
+                   "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane (no "
+                   "self-gather; 0 = off; docs/voxel_cone_tracing.md)"),
         floatParam("origin_offset", 2.0, 0.0, 8.0, "voxels",
                    "cone origin offset along the normal, and first step (repo 2)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "", "stop a cone at this opacity"),
@@ -88,6 +92,7 @@ DvsSettings dvsSettingsFrom(const ParamSet& p) {
     s.stepFactor = p.getFloat("step_factor");
     s.maxDistance = p.getFloat("max_distance");
     s.lodOffset = p.getFloat("lod_offset");
+    s.lift = p.getFloat("lift");
     s.originOffset = p.getFloat("origin_offset");
     s.opacityCutoff = p.getFloat("opacity_cutoff");
     return s;

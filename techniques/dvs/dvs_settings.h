@@ -36,7 +36,8 @@ struct DvsSettings {
     float aoFalloff = 10.0f;    // E11 lambda in 1 / grid side
     float stepFactor = 0.5f;    // E10 beta
     float maxDistance = 0.95f;  // grid sides
-    float lodOffset = 0.0f;     // added to E7 (0 = literal, -1 = repo)
+    float lodOffset = 0.0f;     // added to the radius level (Crassin §5; -1 = node-size reading)
+    float lift = 1.5f;          // sample lift above the surface plane, cells (voxel_cone.glsl)
     float originOffset = 2.0f;  // voxels along the normal (and first step along the cone)
     float opacityCutoff = 0.99f;
 };

@@ -1,5 +1,7 @@
 #include "techniques/dvs/voxel_lighting.h"
 
+#include <algorithm>
+
 #include <glm/glm.hpp>
 
 #include "core/passes/shadow_maps.h"
@@ -91,9 +93,13 @@ DvsVoxelLighting::DvsVoxelLighting(vk::Context& ctx, Voxelizer& voxelizer, Voxel
     const ConeSet cones = makeDiffuseConeSet(kDvsBounceConeCount, dvsBounceApertureDeg());
     BounceUniforms u{};
     u.grid = grid.gpu();
-    // Repo G1 constants (notes 003 §2.6): step 0.5, max 0.95 G; E7 literally (lod bias 0).
-    u.cone = makeConeTraceParams(grid, 0.5f, 0.95f * grid.side(), v0, 0.99f, 0.0f, 0.0f);
-    u.misc = glm::vec4(2.0f * v0, 0.0f, 0.0f, 0.0f);  // one anisotropic voxel along N
+    // G1 marches like the pixel cones (issue 9): the same step, distance, level mapping, lift
+    // and cutoff (the repo's G1 fixed step 0.5, max 0.95 G and E7 literally); its own cone set.
+    const DvsSettings& s = settings;
+    u.cone = makeConeTraceParams(grid, s.stepFactor, s.maxDistance * grid.side(),
+                                 std::max(s.originOffset * v0, v0), s.opacityCutoff, 0.0f,
+                                 s.lodOffset, s.lift);
+    u.misc = glm::vec4(s.originOffset * v0, 0.0f, 0.0f, 0.0f);
     u.cones = toGpu(cones);
     m_bounceUniforms = vk::Buffer(ctx, sizeof(BounceUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                                   vk::MemoryUsage::Upload, memoryTag + "/bounce_uniforms");

@@ -14,7 +14,7 @@ namespace gilab::vct {
 namespace {
 
 constexpr uint32_t kNone = 0xFFFFFFFFu;
-constexpr uint32_t kCounterWords = 4 + 2 * 16;
+constexpr uint32_t kCounterWords = 4 + 2 * 16;  // nodes, bricks, overflow, radiance, ranges
 constexpr VkShaderStageFlags kCs = VK_SHADER_STAGE_COMPUTE_BIT;
 
 struct Push {
@@ -22,7 +22,8 @@ struct Push {
     glm::vec4 scale{0};  // x units per W, y W per unit, z 1 / (pi v0^2)
 };
 
-enum Target : uint32_t { kAccum = 0, kRadiance = 1, kGeometry = 2 };
+// Targets of the transfer / filter passes (SVO_TARGET_* in svo_common.glsl).
+enum Target : uint32_t { kAccum = 0, kRadiance = 1, kGeometry = 2, kDirectional = 3 };
 
 bool isPowerOfTwo(uint32_t n) {
     return n != 0 && (n & (n - 1)) == 0;
@@ -32,6 +33,18 @@ uint32_t log2u(uint32_t n) {
     while ((1u << l) < n)
         ++l;
     return l;
+}
+
+/** Pool texture of `bricks` 3^3 bricks: bricks along x, y, z (x = y = ceil(cbrt)). */
+glm::uvec3 poolBricks(uint32_t bricks, uint32_t maxDim) {
+    bricks = std::max(bricks, 1u);
+    const uint32_t bx =
+        std::clamp<uint32_t>(uint32_t(std::ceil(std::cbrt(double(bricks)))), 1u, maxDim);
+    const uint32_t by = std::min(bx, (bricks + bx - 1) / bx);
+    const uint32_t bz = (bricks + bx * by - 1) / (bx * by);
+    if (bz > maxDim)
+        throw Error("resolution: the octree's brick pool exceeds the device's 3D image size");
+    return {bx, by, bz};
 }
 
 /**
@@ -86,8 +99,9 @@ std::vector<uint8_t> cpuLeafOccupancy(const Scene& scene, const VoxelGrid& grid)
 
 }  // namespace
 
-SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid)
-    : m_vk(&ctx.vk), m_grid(grid) {
+SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid,
+                                     bool anisotropic, DirectionalFilter filter)
+    : m_vk(&ctx.vk), m_grid(grid), m_anisotropic(anisotropic), m_filterMode(filter) {
     const uint32_t n = grid.resolution();
     if (!isPowerOfTwo(n))
         throw Error("resolution: the sparse voxel octree needs a power of two, got " +
@@ -119,7 +133,7 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     }
     std::vector<uint32_t> nodeBound(depthCount, 0);
     nodeBound[0] = 1;
-    uint64_t bricks = 0;
+    uint64_t bricks = 0, leafBricks = 0;
     uint32_t occWords = 0;
     m_info.originVoxelSize = glm::vec4(grid.origin(), grid.voxelSize());
     for (uint32_t d = 0; d < depthCount; ++d) {
@@ -127,6 +141,9 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
         const size_t cellCount = size_t(cn) * cn * cn;
         for (size_t i = 0; i < cellCount; ++i)
             bricks += occ[d][i];
+        if (d == m_leafDepth)
+            for (size_t i = 0; i < cellCount; ++i)
+                leafBricks += occ[d][i];
         if (d + 1 < depthCount) {
             uint32_t tiles = 0;
             const uint32_t fn = 2 * cn;
@@ -151,18 +168,23 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     for (uint32_t b : nodeBound)
         m_nodeCapacity += b;
     m_brickCapacity = uint32_t(std::max<uint64_t>(bricks, 1));
+    // Radiance pool: one brick per leaf; one (isotropic) or six (directional) per inner node.
+    const uint64_t radiance =
+        m_anisotropic ? leafBricks + uint64_t(kFaces) * (bricks - leafBricks) : bricks;
+    if (radiance >= uint64_t(kNone))
+        throw Error("resolution: the octree's radiance pool exceeds 2^32 bricks");
+    m_radianceCapacity = uint32_t(std::max<uint64_t>(radiance, 1));
 
-    // Brick pool texture: bx x by x bz bricks of 3^3 texels.
+    // Brick pool textures: bx x by x bz bricks of 3^3 texels.
     const uint32_t maxDim = ctx.vk.properties().limits.maxImageDimension3D / 3;
-    const uint32_t bx =
-        std::clamp<uint32_t>(uint32_t(std::ceil(std::cbrt(double(m_brickCapacity)))), 1u, maxDim);
-    const uint32_t by = std::min(bx, (m_brickCapacity + bx - 1) / bx);
-    const uint32_t bz = (m_brickCapacity + bx * by - 1) / (bx * by);
-    if (bz > maxDim)
-        throw Error("resolution: the octree's brick pool exceeds the device's 3D image size");
-    m_bricksPerAxis = bx;
-    m_info.dims = glm::uvec4(n, m_leafDepth, bx, depthCount);
-    m_info.capacity = glm::uvec4(m_nodeCapacity, m_brickCapacity, m_floatAtomics ? 1u : 0u, by);
+    const glm::uvec3 gb = poolBricks(m_brickCapacity, maxDim);
+    const glm::uvec3 rb = poolBricks(m_radianceCapacity, maxDim);
+    m_info.dims = glm::uvec4(n, m_leafDepth, gb.x, depthCount);
+    m_info.capacity = glm::uvec4(m_nodeCapacity, m_brickCapacity, m_floatAtomics ? 1u : 0u, gb.y);
+    m_info.radiance =
+        glm::uvec4(m_radianceCapacity, rb.x, rb.y, m_anisotropic ? uint32_t(m_filterMode) : 0u);
+    const uint32_t* maxGroups = ctx.vk.properties().limits.maxComputeWorkGroupCount;
+    m_maxGroups = glm::uvec2(maxGroups[0], maxGroups[1]);
 
     vk::Context& vk = ctx.vk;
     const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -182,12 +204,15 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     vk::ImageDesc desc;
     desc.kind = vk::ImageKind::Image3D;
     desc.format = VK_FORMAT_R16G16B16A16_SFLOAT;
-    desc.width = 3 * bx;
-    desc.height = 3 * by;
-    desc.depth = 3 * bz;
+    desc.width = 3 * rb.x;
+    desc.height = 3 * rb.y;
+    desc.depth = 3 * rb.z;
     desc.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT;
     desc.name = ctx.tag("svo/radiance_bricks");
     m_radiance = vk::Image(vk, desc);
+    desc.width = 3 * gb.x;
+    desc.height = 3 * gb.y;
+    desc.depth = 3 * gb.z;
     desc.name = ctx.tag("svo/geometry_bricks");
     m_geometry = vk::Image(vk, desc);
     vk::SamplerDesc sd;
@@ -234,6 +259,7 @@ void SparseVoxelOctree::createPipelines() {
     m_neighbours = make("vct/svo_neighbours.comp");
     m_leafGeometry = make("vct/svo_leaf_geometry.comp");
     m_filter = make("vct/svo_filter.comp");
+    m_filterAniso = make("vct/svo_filter_aniso.comp");
     m_splat = make(m_floatAtomics ? "vct/svo_splat_float.comp" : "vct/svo_splat.comp");
     m_transfer = make(m_floatAtomics ? "vct/svo_transfer_float.comp" : "vct/svo_transfer.comp");
     m_shade = make(m_floatAtomics ? "vct/svo_shade_float.comp" : "vct/svo_shade.comp");
@@ -262,7 +288,26 @@ void SparseVoxelOctree::bindAndDispatch(VkCommandBuffer cmd, const vk::ComputePi
     push.scale = glm::vec4(float(m_fixedScale), float(1.0 / m_fixedScale), 0.0f, 0.0f);
     push.scale.z = 1.0f / (std::numbers::pi_v<float> * v0 * v0);
     m_layout.push(cmd, push);
-    if (threads > 0) vk::dispatch1D(cmd, threads, 64);
+    dispatch(cmd, threads);
+}
+
+glm::uvec3 SparseVoxelOctree::dispatchGroups(uint64_t threads, uint32_t groupSize, uint32_t maxX,
+                                             uint32_t maxY) {
+    if (threads == 0) return glm::uvec3(0);
+    if (groupSize == 0 || maxX == 0 || maxY == 0)
+        throw Error("SparseVoxelOctree::dispatchGroups: zero group size or limit");
+    const uint64_t groups = (threads + groupSize - 1) / groupSize;
+    const uint64_t x = std::min<uint64_t>(groups, maxX);
+    const uint64_t y = (groups + x - 1) / x;
+    if (y > maxY)
+        throw Error("SparseVoxelOctree: " + std::to_string(threads) +
+                    " threads exceed the device's compute work-group counts");
+    return glm::uvec3(uint32_t(x), uint32_t(y), 1u);
+}
+
+void SparseVoxelOctree::dispatch(VkCommandBuffer cmd, uint64_t threads) const {
+    const glm::uvec3 g = dispatchGroups(threads, kGroupSize, m_maxGroups.x, m_maxGroups.y);
+    if (g.x > 0) vkCmdDispatch(cmd, g.x, g.y, g.z);
 }
 
 void SparseVoxelOctree::transfer(VkCommandBuffer cmd, uint32_t depth, uint32_t target) const {
@@ -276,12 +321,15 @@ void SparseVoxelOctree::transfer(VkCommandBuffer cmd, uint32_t depth, uint32_t t
 }
 
 void SparseVoxelOctree::filterUp(VkCommandBuffer cmd, uint32_t target) const {
+    // Radiance of an anisotropic octree: six directional bricks per inner node.
+    const bool directional = target == kRadiance && m_anisotropic;
+    const uint32_t written = directional ? uint32_t(kDirectional) : target;
     for (int d = int(m_leafDepth) - 1; d >= 0; --d) {
         const uint32_t depth = uint32_t(d);
-        bindAndDispatch(cmd, m_filter, {depth, 0, 0, target},
-                        m_info.depthInfo[depth].z * kBrickSamples, false, false);
+        bindAndDispatch(cmd, directional ? m_filterAniso : m_filter, {depth, 0, 0, written},
+                        uint64_t(m_info.depthInfo[depth].z) * kBrickSamples, false, false);
         vk::memoryBarrier(cmd);
-        transfer(cmd, depth, target);
+        transfer(cmd, depth, written);
     }
 }
 
@@ -301,17 +349,18 @@ void SparseVoxelOctree::build(TechniqueContext& ctx, VkCommandBuffer cmd, VoxelV
     const uint32_t head[6] = {1, 0, 0, 0, 0, 1};  // 1 node allocated; depth 0 = [0, 1)
     vkCmdUpdateBuffer(cmd, m_counters.handle(), 0, sizeof(head), head);
     uint32_t root[kNodeWords] = {0,     kNone, kNone, kNone, kNone, kNone,
-                                 kNone, kNone, kNone, 0,     0,     0};
+                                 kNone, kNone, kNone, 0,     0,     kNone};
     vkCmdUpdateBuffer(cmd, m_nodes.handle(), 0, sizeof(root), root);
     vk::memoryBarrier(cmd);
 
     const uint32_t leafCells = m_info.depthInfo[m_leafDepth].y;
-    bindAndDispatch(cmd, m_occupancyLeaf, {m_leafDepth, 0, 0, 0}, leafCells * leafCells * leafCells,
-                    true, false);
+    bindAndDispatch(cmd, m_occupancyLeaf, {m_leafDepth, 0, 0, 0},
+                    uint64_t(leafCells) * leafCells * leafCells, true, false);
     vk::memoryBarrier(cmd);
     for (int d = int(m_leafDepth) - 1; d >= 0; --d) {
         const uint32_t cn = m_info.depthInfo[d].y;
-        bindAndDispatch(cmd, m_occupancyUp, {uint32_t(d), 0, 0, 0}, cn * cn * cn, false, false);
+        bindAndDispatch(cmd, m_occupancyUp, {uint32_t(d), 0, 0, 0}, uint64_t(cn) * cn * cn, false,
+                        false);
         vk::memoryBarrier(cmd);
     }
     // Top-down: flag, allocate tiles and bricks, initialise (notes 001 §2.2 [C]).
@@ -331,7 +380,7 @@ void SparseVoxelOctree::build(TechniqueContext& ctx, VkCommandBuffer cmd, VoxelV
         bindAndDispatch(cmd, m_neighbours, {d, 0, 0, 0}, m_info.depthInfo[d].z, false, false);
     vk::memoryBarrier(cmd);
     bindAndDispatch(cmd, m_leafGeometry, {m_leafDepth, 0, 0, 0},
-                    m_info.depthInfo[m_leafDepth].z * kBrickSamples, true, false);
+                    uint64_t(m_info.depthInfo[m_leafDepth].z) * kBrickSamples, true, false);
     vk::memoryBarrier(cmd);
     filterUp(cmd, kGeometry);
 }
@@ -355,7 +404,7 @@ void SparseVoxelOctree::inject(TechniqueContext& ctx, VkCommandBuffer cmd,
         PassScope pass(ctx, cmd, "svo_transfer");
         transfer(cmd, m_leafDepth, kAccum);
         bindAndDispatch(cmd, m_shade, {m_leafDepth, 0, 0, 0},
-                        m_info.depthInfo[m_leafDepth].z * kBrickSamples, false, false);
+                        uint64_t(m_info.depthInfo[m_leafDepth].z) * kBrickSamples, false, false);
         vk::memoryBarrier(cmd);
     }
     {
@@ -382,10 +431,14 @@ SparseVoxelOctree::Memory SparseVoxelOctree::memory() const {
     Memory m;
     m.nodeCount = m_nodeCapacity;
     m.brickCount = m_brickCapacity;
+    m.radianceCount = m_radianceCapacity;
     m.nodeBytes = size_t(m_nodeCapacity) * kNodeBytes;
-    const size_t texels =
-        size_t(m_radiance.desc().width) * m_radiance.desc().height * m_radiance.desc().depth;
-    m.brickBytes = 2 * texels * 8;
+    auto bytes = [](const vk::Image& image) {
+        return size_t(image.desc().width) * image.desc().height * image.desc().depth * 8;
+    };
+    m.geometryBytes = bytes(m_geometry);
+    m.radianceBytes = bytes(m_radiance);
+    m.brickBytes = m.geometryBytes + m.radianceBytes;
     m.scratchBytes =
         size_t(m_accum.size() + m_occupancy.size() + m_counters.size() + m_infoBuffer.size());
     return m;
@@ -398,8 +451,11 @@ SparseVoxelOctree::Memory SparseVoxelOctree::usedMemory() const {
     Memory m;
     m.nodeCount = c[0];
     m.brickCount = c[1];
+    m.radianceCount = c[3];
     m.nodeBytes = size_t(c[0]) * kNodeBytes;
-    m.brickBytes = size_t(c[1]) * kBrickBytes;
+    m.geometryBytes = size_t(c[1]) * kBrickBytes;
+    m.radianceBytes = size_t(c[3]) * kBrickBytes;
+    m.brickBytes = m.geometryBytes + m.radianceBytes;
     return m;
 }
 
@@ -428,6 +484,16 @@ std::vector<glm::vec4> SparseVoxelOctree::readGeometryBricks() const {
 glm::uvec3 SparseVoxelOctree::brickTexel(uint32_t brick, glm::uvec3 s) const {
     const uint32_t bx = m_info.dims.z, by = m_info.capacity.w;
     return 3u * glm::uvec3(brick % bx, (brick / bx) % by, brick / (bx * by)) + s;
+}
+
+glm::uvec3 SparseVoxelOctree::radianceTexel(uint32_t slot, glm::uvec3 s) const {
+    const uint32_t bx = m_info.radiance.y, by = m_info.radiance.z;
+    return 3u * glm::uvec3(slot % bx, (slot / bx) % by, slot / (bx * by)) + s;
+}
+
+size_t SparseVoxelOctree::poolTexelIndex(glm::uvec3 t, bool radiance) const {
+    const vk::ImageDesc& d = radiance ? m_radiance.desc() : m_geometry.desc();
+    return t.x + size_t(d.width) * (t.y + size_t(d.height) * t.z);
 }
 
 }  // namespace gilab::vct

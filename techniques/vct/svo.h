@@ -7,9 +7,15 @@
  * volumes at voxel centres (spacing v0); level l bricks have spacing v0 2^l and are filtered with
  * the 3^3 Gaussian. Empty nodes are collapsed (no children, no brick).
  *
+ * Anisotropic (Crassin §9, default in vct): non-leaf nodes store six directional radiance bricks
+ * (-X,+X,-Y,+Y,-Z,+Z, rays travelling toward that direction) built by front-to-back pair
+ * compositing inside the 3^3 Gaussian; leaves stay isotropic. The radiance pool is indexed by a
+ * per-node radiance slot (1 brick, or 6 consecutive bricks for directional nodes); the geometry
+ * pool and the flux accumulators by the node's brick index (docs/vct_svo.md "Anisotropic").
+ *
  * Pools are sized in the constructor from a conservative CPU bound of the occupied leaf cells
  * (triangle / cell overlap on the scene's triangles, dilated by one voxel), so build() and
- * inject() only record into the caller's command buffer. Isotropic voxels only.
+ * inject() only record into the caller's command buffer.
  */
 #include <cstddef>
 #include <cstdint>
@@ -34,14 +40,22 @@ struct GpuSvoInfo {
     glm::vec4 originVoxelSize;  // grid minimum corner, w = v0
     glm::uvec4 dims;      // x N, y leaf depth D (root depth 0), z pool bricks along x, w levels
     glm::uvec4 capacity;  // x node capacity, y brick capacity, z float atomics, w bricks along y
+    glm::uvec4 radiance;  // x radiance brick capacity, y radiance bricks along x, z along y,
+                          // w 1 = anisotropic (non-leaf nodes hold 6 directional bricks)
     glm::uvec4 depthInfo[16];  // per depth d: x occupancy word offset, y cells per axis (2^d),
                                // z bound on the nodes of depth d, w -
 };
-static_assert(sizeof(GpuSvoInfo) == 304);
+static_assert(sizeof(GpuSvoInfo) == 320);
 
 class SparseVoxelOctree {
 public:
-    SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid);
+    /** Directional filter of an anisotropic octree (docs/vct_svo.md "Anisotropic"): Pairs = the
+     *  dense rule (front-to-back pairs) on the two pair halves of the 3^3 tent; Slab = one
+     *  front-to-back step through the tent's footprint (half-depth end samples). */
+    enum class DirectionalFilter : uint32_t { Pairs = 1, Slab = 2 };
+    /** `anisotropic`: six directional radiance bricks per non-leaf node (Crassin §9). */
+    SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid, bool anisotropic,
+                      DirectionalFilter filter = DirectionalFilter::Pairs);
     SparseVoxelOctree(const SparseVoxelOctree&) = delete;
     SparseVoxelOctree& operator=(const SparseVoxelOctree&) = delete;
 
@@ -59,22 +73,29 @@ public:
     static constexpr uint32_t kBindingCount = 3;
 
     struct Memory {
-        size_t nodeBytes = 0, brickBytes = 0;
-        uint32_t nodeCount = 0, brickCount = 0;
+        size_t nodeBytes = 0, brickBytes = 0;  // brickBytes = geometry + radiance pools
+        size_t geometryBytes = 0, radianceBytes = 0;
+        uint32_t nodeCount = 0;
+        uint32_t brickCount = 0;     // nodes with a brick (geometry pool, one brick each)
+        uint32_t radianceCount = 0;  // radiance pool bricks (6 per non-leaf node if anisotropic)
         size_t total() const { return nodeBytes + brickBytes; }
         /** Not in total(): flux accumulators (3 words per leaf sample), occupancy pyramid
          *  (set-up scratch, 1 bit per cell), counters and the info block. */
         size_t scratchBytes = 0;
     };
-    /** Allocated pools (capacity from the CPU bound): bytes of the node pool and brick pools. */
+    /** Allocated pools (capacity from the CPU bound): bytes of the node pool and brick pools
+     *  (whole pool textures, including the padding of their last row of bricks). */
     Memory memory() const;
     /** Nodes and bricks the GPU build actually allocated (blocking read-back; not inside a
      *  submission). Bytes = used count x bytes per node / brick. */
     Memory usedMemory() const;
+    bool anisotropic() const { return m_anisotropic; }
+    DirectionalFilter directionalFilter() const { return m_filterMode; }
     static const char* gatherShaderName() { return "vct/svo_gather.comp"; }
 
     // Introspection for tests and docs.
-    static constexpr uint32_t kNodeWords = 12;  // child, brick, parent, nbr[6], flags, pad
+    static constexpr uint32_t kNodeWords = 12;  // child, brick, parent, nbr[6], cell, depth,
+                                                // radiance slot
     static constexpr uint32_t kBrickSamples = 27;
     const VoxelGrid& grid() const { return m_grid; }
     uint32_t leafDepth() const { return m_leafDepth; }
@@ -82,18 +103,36 @@ public:
     const GpuSvoInfo& info() const { return m_info; }
     /** Raw node pool (kNodeWords uint per node) and the allocation counters (tests). */
     std::vector<uint32_t> readNodes() const;
-    /** Radiance brick pool texels (RGBA, brickSampleIndex order, tests). */
+    /** Radiance / geometry brick pool texels (RGBA, x fastest; index with poolTexelIndex). */
     std::vector<glm::vec4> readRadianceBricks() const;
     std::vector<glm::vec4> readGeometryBricks() const;
-    /** Brick texel position of sample (i,j,k) of brick b in the pool texture. */
+    /** Geometry pool texel of sample (i,j,k) of brick b (node word 1). */
     glm::uvec3 brickTexel(uint32_t brick, glm::uvec3 sample) const;
+    /** Radiance pool texel of sample (i,j,k) of radiance brick `slot` (node word 11, + face
+     *  0..5 = -X,+X,-Y,+Y,-Z,+Z for the directional bricks of a non-leaf node). */
+    glm::uvec3 radianceTexel(uint32_t slot, glm::uvec3 sample) const;
+    /** Index of `texel` in readRadianceBricks() (radiance) or readGeometryBricks(). */
+    size_t poolTexelIndex(glm::uvec3 texel, bool radiance) const;
+
+    /**
+     * Work groups of a launch of `threads` threads in groups of `groupSize`: 1D while the group
+     * count fits `maxX` (maxComputeWorkGroupCount[0]), else a 2D grid x = maxX, y = ceil(groups
+     * / maxX) (the shaders rebuild the index, svoThread() in svo_common.glsl; surplus threads
+     * fail the shaders' bounds checks). Throws past maxY.
+     */
+    static glm::uvec3 dispatchGroups(uint64_t threads, uint32_t groupSize, uint32_t maxX,
+                                     uint32_t maxY);
+    /** Tests: cap the groups per dimension below the device limit to force 2D grids. */
+    void setMaxDispatchGroupsForTesting(uint32_t maxX) { m_maxGroups.x = maxX; }
+    static constexpr uint32_t kGroupSize = 64;  // SVO_GROUP_SIZE of the shaders
 
     /** Fixed-point scale (units per W) of the flux accumulators without float atomics. */
     void setFixedPointScale(double unitsPerWatt) { m_fixedScale = unitsPerWatt; }
     bool usesFloatAtomics() const { return m_floatAtomics; }
-    /** Bytes per node and per brick (radiance + geometry pools). */
+    /** Bytes per node and per brick of one pool (RGBA16F). */
     static constexpr size_t kNodeBytes = kNodeWords * 4;
-    static constexpr size_t kBrickBytes = kBrickSamples * 8 * 2;
+    static constexpr size_t kBrickBytes = kBrickSamples * 8;
+    static constexpr uint32_t kFaces = 6;
 
 private:
     void createPipelines();
@@ -102,12 +141,16 @@ private:
                          bool photonSet) const;
     void transfer(VkCommandBuffer cmd, uint32_t depth, uint32_t target) const;
     void filterUp(VkCommandBuffer cmd, uint32_t target) const;
+    void dispatch(VkCommandBuffer cmd, uint64_t threads) const;
 
     vk::Context* m_vk = nullptr;
     VoxelGrid m_grid;
     uint32_t m_leafDepth = 0;
-    uint32_t m_nodeCapacity = 0, m_brickCapacity = 0, m_bricksPerAxis = 0;
+    uint32_t m_nodeCapacity = 0, m_brickCapacity = 0, m_radianceCapacity = 0;
+    bool m_anisotropic = false;
+    DirectionalFilter m_filterMode = DirectionalFilter::Pairs;
     bool m_floatAtomics = false;
+    glm::uvec2 m_maxGroups{65535u};
     double m_fixedScale = 1048576.0;
     GpuSvoInfo m_info{};
     VkImageView m_voxelView = VK_NULL_HANDLE;
@@ -118,7 +161,7 @@ private:
     vk::Buffer m_counters;    // [0] nodes allocated, [1] bricks allocated, [2] overflow flag
     vk::Buffer m_accum;       // photon flux per leaf brick sample (3 words, float or fixed)
     vk::Buffer m_occupancy;   // set-up scratch: occupancy pyramid, one bit per cell
-    vk::Image m_radiance;     // brick pool: rgb premultiplied radiance, a opacity
+    vk::Image m_radiance;     // radiance pool: rgb premultiplied radiance, a opacity
     vk::Image m_geometry;     // brick pool: rgb alpha * albedo, a opacity
     vk::Sampler m_sampler;
 
@@ -126,7 +169,7 @@ private:
     vk::DescriptorSet m_set, m_voxelSet, m_photonSet;
     vk::PipelineLayout m_layout;
     vk::ComputePipeline m_occupancyLeaf, m_occupancyUp, m_buildLevel, m_neighbours, m_leafGeometry,
-        m_splat, m_transfer, m_shade, m_filter;
+        m_splat, m_transfer, m_shade, m_filter, m_filterAniso;
 };
 
 }  // namespace gilab::vct

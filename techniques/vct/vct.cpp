@@ -72,7 +72,7 @@ TechniqueInfo VctTechnique::describe() {
     info.supports.pointLights = true;
     info.supports.spotLights = true;
     info.supports.directionalLights = true;
-    info.supports.emissiveSurfaces = false;  // the paper injects light-view maps of lights only
+    info.supports.emissiveSurfaces = true;  // emitter samples injected through hemicube maps
     const ParamStage rebuild = ParamStage::Rebuild;
     info.params = {
         intParam("voxel_resolution", 128, 32, 512, "voxels",
@@ -87,7 +87,8 @@ TechniqueInfo VctTechnique::describe() {
                   "3^3 Gaussian filter",
                   rebuild),
         intParam("light_map_resolution", 0, 0, 4096, "texels",
-                 "light-view map side per light view (0 = 2 x voxel_resolution, notes 001 §8)",
+                 "light-view map side per light view (0 = auto: texel footprint <= v0/2 on the "
+                 "farthest grid corner, the paper's rule; clamped to the device limits)",
                  rebuild),
         intParam("diffuse_cones", 6, 1, 16, "",
                  "diffuse cones: one along the normal + a ring (paper timings: 3)"),
@@ -102,15 +103,18 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
                    "cone origin offset along the surface normal, in finest voxels"),
         floatParam("lod_offset", 0.0, -2.0, 2.0, "levels",
-                   "added to the cone's level log2(diameter / v0) (notes 001 §2.9); 0 = the "
-                   "paper's diameter-matched level, < 0 samples finer levels (less "
-                   "self-occlusion, more steps)"),
+                   "added to the cone's level log2(radius / v0) (Crassin §5: the level of the "
+                   "cone radius); -1 = the node-size reading (needs step_factor <= 0.125)"),
+        floatParam("lift", 1.5, 0.0, 4.0, "cells",
+                   "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane so the "
+                   "surface's own cell is never gathered (0 = off; docs/voxel_cone_tracing.md)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "",
                    "a cone stops when its accumulated opacity reaches this"),
         boolParam("specular", true,
                   "one specular cone along the mirrored view direction on glossy pixels"),
-        floatParam("specular_min_aperture_deg", 1.0, 0.1, 60.0, "deg",
-                   "narrowest specular cone (the roughness mapping is clamped to [this, 60])"),
+        floatParam("specular_min_aperture_deg", 10.0, 0.1, 60.0, "deg",
+                   "narrowest specular cone (paper: 10 deg, Table 1; the roughness mapping is "
+                   "clamped to [this, 60])"),
         boolParam("ao", false, "trace AO cones (debug view \"ao\"; not applied to the image)",
                   rebuild),
         floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
@@ -127,8 +131,7 @@ void VctTechnique::setup(TechniqueContext& ctx) {
                     " must be a power of two (mip pyramid / octree levels)");
     }
     int mapRes = p.getInt("light_map_resolution");
-    if (mapRes == 0) mapRes = int(2 * n);
-    if (mapRes < 8) {
+    if (mapRes != 0 && mapRes < 8) {
         throw Error("vct: light_map_resolution = " + std::to_string(mapRes) +
                     " must be 0 (auto) or >= 8");
     }
@@ -146,21 +149,22 @@ void VctTechnique::setup(TechniqueContext& ctx) {
 
     m_grid = VoxelGrid(ctx.scene.caps.bounds, n);
     m_voxelizer = std::make_unique<Voxelizer>(ctx.vk, ctx.gpuScene, m_grid);
-    m_injection = std::make_unique<vct::LightInjection>(ctx, m_grid, uint32_t(mapRes));
+    m_injection = std::make_unique<vct::LightInjection>(ctx, m_grid, uint32_t(mapRes), m_octree);
     ctx.note("voxel grid " + std::to_string(n) + "^3, v0 = " + std::to_string(m_grid.voxelSize()) +
-             " m (paper: 512^3, 9 levels); light-view maps " + std::to_string(mapRes) + "^2 x " +
-             std::to_string(m_injection->viewCount()) +
-             " views = " + std::to_string(m_injection->photonCount()) + " photons");
+             " m (paper: 512^3, 9 levels); light-view maps " + m_injection->mapSummary() + " = " +
+             std::to_string(m_injection->photonCount()) + " photons");
     ctx.note(
         "lights are static: light is injected once at set-up (the paper re-injects when the "
         "light moves)");
-    if (ctx.scene.lights.empty()) ctx.skip("inject", "scene has no punctual lights");
+    if (m_injection->viewCount() == 0) ctx.skip("inject", "no lights and no emitter samples");
 
     if (!m_octree) {
         VoxelRadianceOptions options;
         options.anisotropic = p.getBool("anisotropic");
         options.isotropicFilter = VoxelMipFilter::Gaussian;
         m_radiance = std::make_unique<VoxelRadiance>(ctx.vk, m_grid, options, ctx.tag("radiance"));
+        // Shade voxels toward the cone through their averaged normal (Crassin §7): no back glow
+        m_radiance->setSurfaceNormals(m_voxelizer->volumes().normal);
         ctx.submitTimed([&](VkCommandBuffer cmd) {
             m_voxelizer->record(cmd, ctx.timer);
             {
@@ -187,8 +191,8 @@ void VctTechnique::setup(TechniqueContext& ctx) {
             m_voxelView->record(cmd, ctx.scene.camera, VoxelDebugMode::Albedo);
         });
     } else {
-        ctx.skip("anisotropic", "the octree stores isotropic voxels (3^3 Gaussian filter)");
-        m_svo = std::make_unique<vct::SparseVoxelOctree>(ctx, m_grid);
+        const bool anisotropic = p.getBool("anisotropic");
+        m_svo = std::make_unique<vct::SparseVoxelOctree>(ctx, m_grid, anisotropic);
         ctx.submitTimed([&](VkCommandBuffer cmd) {
             m_voxelizer->record(cmd, ctx.timer);
             {
@@ -202,9 +206,12 @@ void VctTechnique::setup(TechniqueContext& ctx) {
         m_voxelizer.reset();  // the octree holds everything the trace needs
         const vct::SparseVoxelOctree::Memory mem = m_svo->memory();
         const size_t dense = VoxelRadiance::memoryBytesFor(n, VoxelRadianceOptions{});
-        ctx.note("octree nodes " + mib(mem.nodeBytes) + " (" + std::to_string(mem.nodeCount) +
-                 ") + bricks " + mib(mem.brickBytes) + " (" + std::to_string(mem.brickCount) +
-                 "); a dense anisotropic pyramid at this resolution would take " + mib(dense));
+        ctx.note(std::string("octree (") + (anisotropic ? "anisotropic" : "isotropic") +
+                 "): nodes " + mib(mem.nodeBytes) + " (" + std::to_string(mem.nodeCount) +
+                 ") + bricks " + mib(mem.brickBytes) + " (geometry " +
+                 std::to_string(mem.brickCount) + ", radiance " +
+                 std::to_string(mem.radianceCount) + ") = " + mib(mem.total()) +
+                 "; a dense anisotropic pyramid at this resolution would take " + mib(dense));
     }
     if (!ctx.scene.caps.hasGlossy) {
         ctx.skip("specular_cone", "scene has no glossy materials");
@@ -288,7 +295,7 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
         glm::vec4(m_grid.origin() + glm::vec3(m_grid.side()), p.getFloat("step_factor"));
     g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
                             p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
-    g.misc = glm::vec4(p.getFloat("lod_offset"), 0.0f, 0.0f, 0.0f);
+    g.misc = glm::vec4(p.getFloat("lod_offset"), p.getFloat("lift"), 0.0f, 0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
     g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);

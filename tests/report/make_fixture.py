@@ -9,8 +9,10 @@ Contents (schema 1, see scripts/report/report_data.py for what the report reads)
   techniques  "direct" (0 bounces, nothing swept), "tech_a" (1-D sweep of cone_count),
               "tech_b" (2-D grid voxel_res x steps)
   failures    one unsupported run (tech_b, voxel_res=256 on sponza#sun), one nonfinite run
-              (tech_a, cone_count=16 on sponza#sun, magenta pixels), one folder with a malformed
-              result.json, one in-progress folder (.tmp-...) the report must ignore
+              (tech_a, cone_count=16 on sponza#sun, magenta pixels), one invalid run (tech_a,
+              cone_count=64 on cornell_box: Vulkan validation messages; its numbers would make it
+              the best run and put it on the front if it were ranked), one folder with a
+              malformed result.json, one in-progress folder (.tmp-...) the report must ignore
   metrics     final (vs. the bounce-matched reference), final_vs_full, indirect (techniques with
               bounces), regions, energy_ratio; key names as experiments/metrics toJson writes them
   images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), and final/indirect/flip
@@ -47,6 +49,15 @@ SKIPPED = {
                    "over 85 deg)"],
 }
 REGIONS = ("ceiling", "indirect_dominant")
+# What the runner saves for a run during which the validation layer complained.
+INVALID_MESSAGES = [
+    "[error] Validation Error: [ VUID-vkCmdDispatch-groupCountX-00386 ] Object 0: handle = "
+    "0x55d0c2a1b2c0, name = tech_a/filter, type = VK_OBJECT_TYPE_COMMAND_BUFFER; | "
+    "vkCmdDispatch(): groupCountX (104875) exceeds device limit maxComputeWorkGroupCount[0] "
+    "(65535). The Vulkan spec states: groupCountX must be less than or equal to "
+    "VkPhysicalDeviceLimits::maxComputeWorkGroupCount[0] <script>alert(1)</script>",
+    "[warning] Validation Performance Warning: a second, made-up message",
+]
 
 
 @dataclass
@@ -62,6 +73,7 @@ class Spec:
     nan_pixels: int = 0
     index: int = 0
     notes: list[str] = field(default_factory=list)
+    validation: list[str] = field(default_factory=list)  # messages; any makes it "invalid"
 
 
 def run_specs(sweeps: bool) -> list[Spec]:
@@ -84,6 +96,8 @@ def run_specs(sweeps: bool) -> list[Spec]:
                       swept_b, status="unsupported",
                       reason="tech_b: a 256^3 voxel grid needs 2.0 GiB, over the device's "
                              "1.0 GiB allocation limit"))
+    specs.append(Spec("cornell_box", "tech_a", {"cone_count": 64, "max_distance": 1.5}, swept_a,
+                      status="invalid", validation=INVALID_MESSAGES))
     for i, spec in enumerate(specs):
         spec.index = i
     return specs
@@ -338,6 +352,13 @@ def memory_json(spec: Spec) -> dict:
             "by_resource": {f"{k}/all": v for k, v in owners.items()}}
 
 
+def validation_json(messages: list[str]) -> dict:
+    """The runner's "validation" block: counts by severity and the messages."""
+    errors = sum(1 for m in messages if m.startswith("[error]"))
+    return {"enabled": True, "errors": errors, "warnings": len(messages) - errors,
+            "messages": messages}
+
+
 def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> None:
     key = run_key(spec)
     folder = os.path.join(root, "runs", key)
@@ -379,7 +400,7 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
             "nonfinite": {layer: {"nan_pixels": spec.nan_pixels if layer == "final" else 0,
                                   "inf_pixels": 0, "negative_pixels": 0}
                           for layer in ("final", "indirect", "direct")},
-            "validation": {"errors": 0, "warnings": 0},
+            "validation": validation_json(spec.validation),
             "outputs": {"exr": "output.exr", "final_png": "final.png",
                         "indirect_png": "indirect.png", "flip_png": "flip.png"}})
     with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:

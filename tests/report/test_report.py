@@ -243,8 +243,10 @@ def check_main(checks: Checks, tmp: str) -> None:
     flip_cells = [a for tag, a in items if tag == "td" and has_class(a, "c-flip")]
     checks.check(len(flip_cells) == expected and "±" in dom, "FLIP column with error bars")
     images = [a for tag, a in items if tag == "img" and a.get("src", "").startswith("runs/")]
-    checks.check(len(images) >= 2 * (expected - 1), "final and FLIP images of every run",
+    checks.check(len(images) >= 2 * (expected - 2),
+                 "final and FLIP images of every run but the unsupported and the invalid one",
                  f"{len(images)} run images")
+    check_invalid(checks, fixture, dom, items)
     refs = {a["src"].split("/")[1] for tag, a in items
             if tag == "img" and a.get("src", "").startswith("references/")}
     checks.check(refs == {"cornell_box", "sponza_sun"}, "reference images of both scenes shown",
@@ -256,6 +258,45 @@ def check_main(checks: Checks, tmp: str) -> None:
     size = os.path.getsize(shot) if os.path.isfile(shot) else 0
     checks.check(size > 10_000, f"screenshot is a non-trivial PNG ({size} bytes)",
                  result.stderr[-300:])
+
+
+def invalid_keys(results_dir: str) -> list[str]:
+    """Keys of the fixture's runs with status "invalid"."""
+    keys = []
+    for name in os.listdir(os.path.join(results_dir, "runs")):
+        path = os.path.join(results_dir, "runs", name, "result.json")
+        if not name.startswith(".") and os.path.isfile(path):
+            with open(path, encoding="utf-8") as f:
+                keys += [name] if '"status": "invalid"' in f.read() else []
+    return keys
+
+
+def check_invalid(checks: Checks, results_dir: str, dom: str,
+                  items: list[tuple[str, dict[str, str]]]) -> None:
+    """An invalid run is flagged at the top and in its row, and never shown or ranked as ok."""
+    keys = invalid_keys(results_dir)
+    if not checks.check(len(keys) == 1, "the fixture has one invalid run", str(keys)):
+        return
+    key = keys[0]
+    banner = re.search(r'<div class="warn invalid" id="invalid">(.*?)</div>', dom, re.S)
+    checks.check(bool(banner) and "1 invalid run" in banner.group(1)
+                 and "VUID-vkCmdDispatch-groupCountX-00386" in banner.group(1)
+                 and "1 validation error, 1 warning" in banner.group(1),
+                 "a warning banner lists the invalid run with its counts and first message")
+    checks.check(dom.find('id="invalid"') < dom.find('id="runs"'),
+                 "the invalid-run banner comes before the run table")
+    with open(os.path.join(results_dir, "report.html"), encoding="utf-8") as f:
+        checks.check("<script>alert" not in f.read(), "validation messages are escaped")
+    row = re.search(rf'<tr class="([^"]*)" data-key="{key}">(.*?)</tr>', dom, re.S)
+    checks.check(bool(row) and "invalid" in row.group(1).split() and "st-invalid" in row.group(2)
+                 and "validation error" in row.group(2),
+                 "the invalid run's row is marked and its status cell says why")
+    checks.check(bool(row) and "b-front" not in row.group(2),
+                 "the invalid run is not on a Pareto front (it has the lowest error)")
+    checks.check(not any(key in a.get("src", "") for tag, a in items if tag == "img"),
+                 "the invalid run has no image card (never the best run)")
+    checks.check("st-invalid" in dom.split('id="runs"')[0],
+                 "the header counts the invalid run")
 
 
 def check_no_sweeps(checks: Checks, tmp: str) -> None:
@@ -325,6 +366,7 @@ HOSTILE_RUNS = {
         "rel_mse": None, "error_bars": {"available": True, "flip": None}}, "regions": {
         "r": None}}, "reference": {"final_png": None}},
     "unknown_status": {"status": "running"},
+    "invalid_odd": {"status": "invalid", "validation": {"errors": "x", "messages": [None, 5]}},
 }
 
 
@@ -346,8 +388,8 @@ def check_hostile(checks: Checks, tmp: str) -> None:
     if not os.path.isfile(page):
         return
     dom = load_dom(checks, tmp, page, "hostile page")
-    checks.check(run_rows(elements(dom)) == 3 and dom.count("st-unreadable") >= 4,
-                 "hostile values: 3 runs shown, 3 folders listed as unreadable")
+    checks.check(run_rows(elements(dom)) == 4 and dom.count("st-unreadable") >= 4,
+                 "hostile values: 4 runs shown, 3 folders listed as unreadable")
 
 
 def check_edges(checks: Checks, tmp: str) -> None:
