@@ -431,6 +431,7 @@ struct ConeQuery {
     glm::vec4 originTanHalf;
     glm::vec4 dirMode;
     ConeTraceParams params;
+    glm::vec4 normal{0.0f};  // mode 3: surface normal, w origin offset
 };
 struct ConePush {
     GpuVoxelGrid grid;
@@ -492,6 +493,13 @@ public:
     }
     ConeQuery sample(glm::vec3 pos, float lod, glm::vec3 dir) const {
         return {glm::vec4(pos, lod), glm::vec4(dir, 2.0f), params()};
+    }
+    ConeQuery surfaceCone(glm::vec3 point, glm::vec3 normal, float offset, glm::vec3 dir,
+                          float tanHalf, const ConeTraceParams& p) const {
+        return {glm::vec4(point, tanHalf), glm::vec4(dir, 3.0f), p, glm::vec4(normal, offset)};
+    }
+    ConeQuery level(float t, float tanHalf, const ConeTraceParams& p) const {
+        return {glm::vec4(t, 0.0f, 0.0f, tanHalf), glm::vec4(1.0f, 0.0f, 0.0f, 4.0f), p};
     }
 
 private:
@@ -594,6 +602,109 @@ TEST_F(GpuVoxelCone, OpaqueEmittingWallReturnsItsRadiance) {
         EXPECT_EQ(r[2], glm::vec4(0.0f));
         EXPECT_NEAR(r[3].a, 0.0f, 0.02f);  // fully occluded
     }
+}
+
+TEST_F(GpuVoxelCone, LevelIsTheConeRadiusLevel) {
+    // Crassin §5: the level whose voxel size is the cone radius t tan(theta/2), plus the bias.
+    const uint32_t n = 32;
+    VoxelRadiance rad(*m_ctx, testGrid(n), exactAniso(), "test/radiance");
+    ConeRunner runner(*m_ctx, rad);
+    const float v0 = rad.grid().voxelSize();
+    ConeTraceParams biased = runner.params();
+    biased.misc.x = -1.0f;
+    std::vector<ConeQuery> q;
+    const float ts[4] = {4.0f, 8.0f, 16.0f, 24.0f};  // in v0
+    for (float t : ts)
+        q.push_back(runner.level(t * v0, 0.5f, runner.params()));
+    for (float t : ts)
+        q.push_back(runner.level(t * v0, 0.5f, biased));
+    q.push_back(runner.level(0.5f * v0, 0.5f, runner.params()));  // below v0: level 0
+    const std::vector<glm::vec4> r = runner.run(q);
+    for (int i = 0; i < 4; ++i) {
+        const float radiusLevel = std::log2(ts[i] * 0.5f);  // radius / v0 = t tan = t / 2
+        EXPECT_NEAR(r[size_t(i)].x, radiusLevel, 1e-4f) << "t = " << ts[i] << " v0";
+        EXPECT_NEAR(r[size_t(i) + 4].x, std::max(radiusLevel - 1.0f, 0.0f), 1e-4f);
+    }
+    EXPECT_EQ(r[8].x, 0.0f);
+}
+
+TEST_F(GpuVoxelCone, FacingHidesTheBackOfAWall) {
+    // A one-voxel wall at x = 16 facing -x (toward x = 6). Seen from the front it shines, from
+    // behind it is black but still opaque (Crassin §7: shade toward the cone through the
+    // averaged normal); without normals it shines both ways.
+    const uint32_t n = 32;
+    const glm::vec4 wall(2.0f, 1.0f, 0.5f, 1.0f);
+    Volume v(size_t(n) * n * n, glm::vec4(0.0f)), normals(size_t(n) * n * n, glm::vec4(0.0f));
+    for (int z = 0; z < int(n); ++z)
+        for (int y = 0; y < int(n); ++y) {
+            v[idx(n, 16, y, z)] = wall;
+            normals[idx(n, 16, y, z)] = glm::vec4(-1.0f, 0.0f, 0.0f, 1.0f);
+        }
+    vk::ImageDesc nd;
+    nd.kind = vk::ImageKind::Image3D;
+    nd.format = VK_FORMAT_R32G32B32A32_SFLOAT;
+    nd.width = nd.height = nd.depth = n;
+    nd.usage = VK_IMAGE_USAGE_SAMPLED_BIT;
+    nd.name = "test/normals";
+    vk::Image normalImage(*m_ctx, nd);
+    normalImage.upload(*m_ctx, normals.data(), normals.size() * sizeof(glm::vec4));
+    for (bool withNormals : {true, false}) {
+        SCOPED_TRACE(withNormals ? "facing" : "isotropic");
+        VoxelRadiance rad(*m_ctx, testGrid(n), VoxelRadianceOptions{}, "test/radiance");
+        if (withNormals) rad.setSurfaceNormals(normalImage);
+        uploadAndFilter(*m_ctx, rad, v);
+        ConeRunner runner(*m_ctx, rad);
+        const VoxelGrid& g = rad.grid();
+        const glm::vec3 front = g.gridToWorld(glm::vec3(6.0f, 16.0f, 16.0f));
+        const glm::vec3 back = g.gridToWorld(glm::vec3(27.0f, 16.0f, 16.0f));
+        const std::vector<glm::vec4> r = runner.run({
+            runner.trace(front, {1, 0, 0}, 0.05f, runner.params()),   // base level
+            runner.trace(back, {-1, 0, 0}, 0.05f, runner.params()),
+            runner.trace(front, {1, 0, 0}, 0.3f, runner.params()),    // directional levels
+            runner.trace(back, {-1, 0, 0}, 0.3f, runner.params()),
+        });
+        for (int i : {0, 2}) {
+            EXPECT_GT(r[size_t(i)].a, 0.5f) << i;
+            EXPECT_NEAR(r[size_t(i)].r / r[size_t(i)].a, wall.r, 0.05f * wall.r) << i;
+        }
+        for (int i : {1, 3}) {
+            EXPECT_NEAR(r[size_t(i)].a, r[size_t(i) - 1].a, 0.05f) << i;  // opacity both ways
+            if (withNormals)
+                EXPECT_LT(r[size_t(i)].r, 0.02f * wall.r) << i;
+            else
+                EXPECT_NEAR(r[size_t(i)].r, r[size_t(i) - 1].r, 0.05f * wall.r) << i;
+        }
+    }
+}
+
+TEST_F(GpuVoxelCone, LiftKeepsASurfaceOutOfItsOwnCones) {
+    // An emitting floor (y < 6, isotropic: no normals) and a 60 deg cone leaving its top surface
+    // tilted 60 deg: the lift keeps every sample 1.5 cells of its level above the plane, so the
+    // floor's own cells are never gathered; without the lift the coarse cells return its light.
+    const uint32_t n = 32;
+    const glm::vec4 floorColor(1.0f, 1.0f, 1.0f, 1.0f);
+    Volume v(size_t(n) * n * n, glm::vec4(0.0f));
+    for (int z = 0; z < int(n); ++z)
+        for (int y = 0; y < 6; ++y)  // not on a coarse cell boundary
+            for (int x = 0; x < int(n); ++x)
+                v[idx(n, x, y, z)] = floorColor;
+    VoxelRadiance rad(*m_ctx, testGrid(n), VoxelRadianceOptions{}, "test/radiance");
+    uploadAndFilter(*m_ctx, rad, v);
+    ConeRunner runner(*m_ctx, rad);
+    const VoxelGrid& g = rad.grid();
+    const float v0 = g.voxelSize();
+    const glm::vec3 point = g.gridToWorld(glm::vec3(16.0f, 6.0f, 16.0f));
+    const glm::vec3 dir = glm::normalize(glm::vec3(std::sin(1.047f), std::cos(1.047f), 0.0f));
+    ConeTraceParams lifted = runner.params(), flat = runner.params();
+    lifted.misc.y = 1.5f;
+    lifted.distances.y = flat.distances.y = 1.5f * v0;  // t0
+    const std::vector<glm::vec4> r = runner.run({
+        runner.surfaceCone(point, {0, 1, 0}, 1.5f * v0, dir, 0.577f, lifted),
+        runner.surfaceCone(point, {0, 1, 0}, 1.5f * v0, dir, 0.577f, flat),
+    });
+    std::printf("floor light gathered: lifted %.4f, not lifted %.4f\n", r[0].r, r[1].r);
+    EXPECT_LT(r[0].r, 1e-3f);
+    EXPECT_GT(r[1].r, 0.01f);
 }
 
 TEST_F(GpuVoxelCone, OpacityCorrectionMakesStepFactorIrrelevant) {

@@ -145,6 +145,25 @@ int runMain(int argc, char** argv) {
     benchRefCmd->add_option("--out,-o", benchRef.outDir, "Also write bench_reference.json here");
     benchRefCmd->add_flag("--quiet,-q", benchRef.quiet, "No progress lines");
 
+    BenchTechniqueOptions benchTech;
+    CLI::App* benchTechCmd = bench->add_subcommand(
+        "technique", "Set-up and per-frame GPU times per pass of techniques (median, IQR)");
+    benchTechCmd->add_option("--scene", benchTech.scenePath,
+                             "Scene description (file.json#variant); default: built-in Cornell");
+    benchTechCmd->add_option("--technique,-t", benchTech.techniques,
+                             "Technique (repeatable); default: every registered technique");
+    benchTechCmd->add_option("--set", benchTech.assignments,
+                             "key=value for every technique, or shared.key=value (repeatable)");
+    benchTechCmd->add_option("--resolution", benchTech.resolution, "WxH")->capture_default_str();
+    benchTechCmd->add_option("--warmup", benchTech.warmupFrames, "Frames discarded first")
+        ->check(CLI::Range(0, 1000))
+        ->capture_default_str();
+    benchTechCmd->add_option("--frames", benchTech.frames, "Timed frames")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    benchTechCmd->add_option("--device", benchTech.device, "Vulkan device name substring or index");
+    benchTechCmd->add_flag("--quiet,-q", benchTech.quiet, "No progress lines");
+
     exp::RunnerOptions run;
     run.commandLine = commandLine;
     std::string shard;
@@ -187,6 +206,7 @@ int runMain(int argc, char** argv) {
         if (*rend) return runRender(render);
         if (*ref) return runReference(reference);
         if (*benchRefCmd) return runBenchReference(benchRef);
+        if (*benchTechCmd) return runBenchTechnique(benchTech);
         if (*runCmd) {
             if (!shard.empty()) std::tie(run.shardIndex, run.shardCount) = exp::parseShard(shard);
             return runExperimentCommand(run);

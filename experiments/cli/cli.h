@@ -9,6 +9,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "core/params/params.h"
 #include "core/scene/scene.h"
 
 namespace gilab::cli {
@@ -45,6 +46,24 @@ struct RenderOptions {
     std::string commandLine;
 };
 int runRender(const RenderOptions& options);
+
+/** Splits --set assignments ("key=value", "shared.key=value") between the technique's and the
+ *  shared passes' parameter sets; unknown keys and bad values throw gilab::Error naming them. */
+void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
+                      ParamSet& shared);
+
+/** `gilab bench technique`: set-up and per-frame GPU times of techniques, printed as a table. */
+struct BenchTechniqueOptions {
+    std::string scenePath;                  // "" = the built-in Cornell box
+    std::vector<std::string> techniques;    // default: every registered technique
+    std::vector<std::string> assignments;   // applied to every technique (must exist in each)
+    std::string resolution = "256x256";
+    int warmupFrames = 1;
+    int frames = 5;
+    std::string device;
+    bool quiet = false;
+};
+int runBenchTechnique(const BenchTechniqueOptions& options);
 
 /** Options of `gilab reference` (docs/reference_cache.md), also used by tests. */
 struct ReferenceOptions {

@@ -17,9 +17,7 @@
 #include "experiments/runner/run_store.h"
 
 namespace gilab::cli {
-namespace {
 
-/** Splits --set assignments between the technique's and the shared passes' parameter sets. */
 void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
                       ParamSet& shared) {
     for (const std::string& a : assignments) {
@@ -30,6 +28,8 @@ void applyAssignments(const std::vector<std::string>& assignments, ParamSet& tec
             technique.set(key, value);
     }
 }
+
+namespace {
 
 /** Prints the validation summary of a run that reported messages (they are in the sidecar). */
 void reportValidation(const nlohmann::ordered_json& validation, const std::string& jsonPath) {

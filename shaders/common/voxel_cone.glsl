@@ -2,7 +2,10 @@
 // notes 003 §2.8). Before including, define
 //     vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir);
 // returning premultiplied radiance (rgb) and opacity (a) at level `lod` (0 = finest voxel size v0,
-// fractional = linear between levels) for a cone travelling along unit `dir`.
+// fractional = linear between levels) for a cone travelling along unit `dir`. Optionally also
+//     #define VOXEL_CONE_HAS_COARSE_SAMPLE
+//     vec4 voxelConeSampleCoarse(vec3 worldPos, float lod, vec3 dir);   (lod >= 1 only)
+// a cheaper sampler for the samples at level >= 1.
 //
 // Level mapping (Crassin §5: "the level corresponding to the cone radius"): the sampled voxel
 // size equals the cone radius r(t) = t tan(theta/2), L = log2(r / v0) + bias, clamped to >= 0.
@@ -18,6 +21,12 @@
 #define VOXEL_CONE_MAX_STEPS 1024
 #endif
 
+#ifndef VOXEL_CONE_HAS_COARSE_SAMPLE
+vec4 voxelConeSampleCoarse(vec3 worldPos, float lod, vec3 dir) {
+    return voxelConeSample(worldPos, lod, dir);
+}
+#endif
+
 struct ConeTraceParams {
     vec4 gridMinV0;    // xyz grid minimum corner, w = v0 (finest voxel size)
     vec4 gridMaxStep;  // xyz grid maximum corner, w = step factor (d' = step * diameter, E10)
@@ -27,16 +36,16 @@ struct ConeTraceParams {
                        // zw reserved
 };
 
-// Cone diameter at distance t (notes 003 E6).
-float coneDiameter(float t, float tanHalf) {
-    return max(2.0 * max(t, 0.0) * max(tanHalf, 0.0), 0.0);
+// Cone diameter at distance t (notes 003 E6), never below the finest voxel size v0.
+float coneDiameter(float t, float tanHalf, float v0) {
+    return max(2.0 * max(t, 0.0) * max(tanHalf, 0.0), v0);
 }
 
-// Level whose voxel size matches the cone radius diameter / 2 (Crassin §5); 0 = finest.
-// Safe for d = 0 and v0 = 0.
-float coneLod(float diameter, float v0) {
-    if (!(diameter > 0.0) || !(v0 > 0.0)) return 0.0;
-    return max(0.0, log2(0.5 * diameter / v0));
+// The sampled level at distance t: the level whose voxel size is the cone radius (Crassin §5),
+// L = log2(radius / v0) + bias, clamped to >= 0 (0 = finest). v0 > 0.
+float coneLevel(float t, float tanHalf, ConeTraceParams p) {
+    float v0 = p.gridMinV0.w;
+    return max(log2(0.5 * coneDiameter(t, tanHalf, v0) / v0) + p.misc.x, 0.0);
 }
 
 // Deterministic tangent frame around n (unit; a zero n falls back to +z).
@@ -81,12 +90,69 @@ ConeSurface coneNoSurface() { return ConeSurface(vec3(0.0), vec3(0.0)); }
 #define CONE_MODE_RADIANCE 0
 #define CONE_MODE_OCCLUSION 1
 
+// State of one march (coneMarch).
+struct ConeMarchState {
+    vec3 color;
+    float alpha;
+    float t;
+    bool done;
+};
+
+// One sample of coneMarch at distance st.t; `fine` (a literal at every call, so the compiler
+// drops the other sampler) selects voxelConeSample or voxelConeSampleCoarse.
+void coneMarchStep(inout ConeMarchState st, bool fine, vec3 origin, vec3 dir, float tanHalf,
+                   ConeSurface surface, float maxDistance, int mode, ConeTraceParams p) {
+    float v0 = p.gridMinV0.w;
+    float cutoff = p.distances.z > 0.0 ? p.distances.z : 1.0;
+    if (st.t > maxDistance || st.alpha >= cutoff) {
+        st.done = true;
+        return;
+    }
+    float d = coneDiameter(st.t, tanHalf, v0);
+    float lod = coneLevel(st.t, tanHalf, p);
+    float level = exp2(lod);  // sampled voxel size / v0
+    vec3 pos = origin + st.t * dir;
+    if (!coneInsideGrid(pos, p)) {  // the axis left the grid: nothing more to gather
+        st.done = true;
+        return;
+    }
+    float liftFactor = max(p.misc.y, 0.0) * v0;
+    if (liftFactor > 0.0 && dot(surface.normal, surface.normal) > 0.25) {
+        // Notes 001 §2.9: the cell of size v0 2^ceil(L) holding the surface stays out of the
+        // trilinear footprint when the sample is >= 1.5 cells above the plane.
+        float h = dot(pos - surface.point, surface.normal);
+        float need = liftFactor * exp2(ceil(lod)) - h;
+        if (need > 0.0) {
+            // Where the grid ends closer than that along n (an open side of the scene), sample
+            // the coarsest level whose lift stays inside instead of empty space.
+            float room = coneExitDistance(pos, surface.normal, p);
+            if (need > room) {
+                lod = min(lod, max(floor(log2(max(h + room, 1e-30) / liftFactor)), 0.0));
+                level = exp2(lod);
+                need = min(liftFactor * exp2(ceil(lod)) - h, room);
+            }
+            pos += max(need, 0.0) * surface.normal;
+        }
+    }
+    float stepLen = max(p.gridMaxStep.w, 0.01) * d;
+    vec4 s = fine ? voxelConeSample(pos, lod, dir) : voxelConeSampleCoarse(pos, lod, dir);
+    if (mode == CONE_MODE_OCCLUSION) {
+        s = vec4(0.0, 0.0, 0.0, s.a / (1.0 + max(p.distances.w, 0.0) * st.t));
+    }
+    // d'/d: the step against the voxel size of the sampled level.
+    s = coneCorrectSample(s, stepLen / (v0 * level));
+    st.color += (1.0 - st.alpha) * s.rgb;
+    st.alpha += (1.0 - st.alpha) * s.a;
+    st.t += stepLen;
+}
+
 // The one cone march every caller shares. mode RADIANCE: rgb = gathered radiance (premultiplied
 // front-to-back sum C += (1 - A) c', A += (1 - A) a', notes 001 §8 choice), a = opacity.
 // mode OCCLUSION: a = accumulated occlusion of the falloff-weighted opacity f(t) a with
 // f = 1 / (1 + lambda t) (Crassin §6; the step correction applies to f a, so the result does
-// not depend on the step factor), rgb = 0. Stops at the cutoff, t > maxDistance, outside the grid
-// or after VOXEL_CONE_MAX_STEPS.
+// not depend on the step factor), rgb = 0. Stops at the cutoff, t > maxDistance, when the axis
+// leaves the grid or after VOXEL_CONE_MAX_STEPS. Two loops: samples below level 1 (fine: the
+// storage may read its finest level), then the rest (coarse), so no sample pays for both.
 vec4 coneMarch(vec3 origin, vec3 dir, float tanHalf, ConeSurface surface, float maxDistance,
                int mode, ConeTraceParams p) {
     float len = length(dir);
@@ -94,49 +160,15 @@ vec4 coneMarch(vec3 origin, vec3 dir, float tanHalf, ConeSurface surface, float 
     if (!(len > 1e-8) || !(v0 > 0.0)) return vec4(0.0);
     dir /= len;
     tanHalf = max(tanHalf, 0.0);
-    float stepFactor = max(p.gridMaxStep.w, 0.01);
-    float cutoff = p.distances.z > 0.0 ? p.distances.z : 1.0;
-    float lambda = mode == CONE_MODE_OCCLUSION ? max(p.distances.w, 0.0) : 0.0;
-    float bias = p.misc.x;
-    float liftFactor = max(p.misc.y, 0.0) * v0;
-    bool lift = liftFactor > 0.0 && dot(surface.normal, surface.normal) > 0.25;
-    vec3 color = vec3(0.0);
-    float alpha = 0.0;
-    float t = max(p.distances.y, 0.0);
-    for (int i = 0; i < VOXEL_CONE_MAX_STEPS; ++i) {
-        if (t > maxDistance || alpha >= cutoff) break;
-        float d = max(2.0 * t * tanHalf, v0);
-        float lod = max(log2(0.5 * d / v0) + bias, 0.0);
-        float level = exp2(lod);  // sampled voxel size / v0
-        vec3 pos = origin + t * dir;
-        if (!coneInsideGrid(pos, p)) break;  // the axis left the grid: nothing more to gather
-        if (lift) {
-            // Notes 001 §2.9: the cell of size v0 2^ceil(L) holding the surface stays out of
-            // the trilinear footprint when the sample is >= 1.5 cells above the plane.
-            float h = dot(pos - surface.point, surface.normal);
-            float need = liftFactor * exp2(ceil(lod)) - h;
-            if (need > 0.0) {
-                // Where the grid ends closer than that along n (an open side of the scene),
-                // sample the coarsest level whose lift stays inside instead of empty space.
-                float room = coneExitDistance(pos, surface.normal, p);
-                if (need > room) {
-                    lod = min(lod, max(floor(log2(max(h + room, 1e-30) / liftFactor)), 0.0));
-                    level = exp2(lod);
-                    need = min(liftFactor * exp2(ceil(lod)) - h, room);
-                }
-                pos += max(need, 0.0) * surface.normal;
-            }
-        }
-        float stepLen = stepFactor * d;
-        vec4 s = voxelConeSample(pos, lod, dir);
-        if (mode == CONE_MODE_OCCLUSION) s = vec4(0.0, 0.0, 0.0, s.a / (1.0 + lambda * t));
-        // d'/d: the step against the voxel size of the sampled level.
-        s = coneCorrectSample(s, stepLen / (v0 * level));
-        color += (1.0 - alpha) * s.rgb;
-        alpha += (1.0 - alpha) * s.a;
-        t += stepLen;
-    }
-    return vec4(color, clamp(alpha, 0.0, 1.0));
+    ConeMarchState st = ConeMarchState(vec3(0.0), 0.0, max(p.distances.y, 0.0), false);
+    // The nominal level reaches 1 at t1 (radius 2^(1 - bias) v0).
+    float t1 = tanHalf > 0.0 ? exp2(1.0 - p.misc.x) * v0 / tanHalf : 3.0e38;
+    int i = 0;
+    for (; i < VOXEL_CONE_MAX_STEPS && !st.done && st.t < t1; ++i)
+        coneMarchStep(st, true, origin, dir, tanHalf, surface, maxDistance, mode, p);
+    for (; i < VOXEL_CONE_MAX_STEPS && !st.done; ++i)
+        coneMarchStep(st, false, origin, dir, tanHalf, surface, maxDistance, mode, p);
+    return vec4(st.color, clamp(st.alpha, 0.0, 1.0));
 }
 
 // A cone from a free point (no surface, no lift): radiance and opacity.

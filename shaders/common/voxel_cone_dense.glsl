@@ -65,7 +65,8 @@ vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
 #else
     // Shade the base toward the cone (the directional levels are built facing-weighted)
     vec4 base = textureLod(voxelConeBase, uvw, 0.0);
-    base.rgb *= voxelFacing(textureLod(voxelConeNormals, uvw, 0.0), dir);
+    vec4 nl = textureLod(voxelConeNormals, uvw, 0.0);
+    base.rgb *= voxelFacing(voxelMeanNormalFiltered(nl, base.a), dir);
     vec4 directional = voxelConeDirectional(uvw, max(lod - 1.0, 0.0), dir);
     s = mix(base, directional, clamp(lod, 0.0, 1.0));
 #endif
@@ -75,6 +76,16 @@ vec4 voxelConeSample(vec3 worldPos, float lod, vec3 dir) {
     return vec4(s.rgb, min(s.a, 1.0));
 }
 
+// Samples at level >= 1 read the directional levels only (voxel_cone.glsl's second loop).
+vec4 voxelConeSampleCoarse(vec3 worldPos, float lod, vec3 dir) {
+    vec3 uvw = voxelWorldToUvw(voxelConeGrid(), worldPos);
+    if (any(lessThan(uvw, vec3(0.0))) || any(greaterThan(uvw, vec3(1.0)))) return vec4(0.0);
+    vec4 s = max(voxelConeDirectional(uvw, max(lod - 1.0, 0.0), dir), vec4(0.0));
+    if (!(s.a > 0.0)) return vec4(0.0);
+    return vec4(s.rgb, min(s.a, 1.0));
+}
+
+#define VOXEL_CONE_HAS_COARSE_SAMPLE
 #include "common/voxel_cone.glsl"
 
 #endif  // GILAB_VOXEL_CONE_DENSE_GLSL

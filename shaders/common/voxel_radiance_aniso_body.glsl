@@ -28,7 +28,8 @@ const vec3 kFaceTravel[6] = vec3[6](vec3(-1, 0, 0), vec3(1, 0, 0), vec3(0, -1, 0
 // A child's premultiplied value as seen by rays of face f (colour facing-weighted, opacity kept).
 vec4 facingChild(int i, int f) {
     if (!SHARED_SOURCE) return children[i];
-    return vec4(children[i].rgb * voxelFacing(childNormals[i], kFaceTravel[f]), children[i].a);
+    return vec4(children[i].rgb * voxelFacing(voxelMeanNormal(childNormals[i]), kFaceTravel[f]),
+                children[i].a);
 }
 
 

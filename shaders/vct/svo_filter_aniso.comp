@@ -17,7 +17,12 @@
 // a parent computes the pairs of its own children and the add/copy transfer across parents
 // completes boundary samples exactly, as for the isotropic filter. For small opacities P_f is
 // twice the Gaussian (a parent voxel is twice as thick); a one-voxel wall through a parent's
-// centre sample keeps a = 1 along its normal.
+// centre sample keeps a = 1 along its normal (on an odd child sample: 1/2 in both parents).
+// Slab filter (svo.radiance.w = SVO_ANISO_SLAB, SparseVoxelOctree::DirectionalFilter::Slab): one
+// front-to-back step through the footprint 2i-1 .. 2i+1 with half-depth end samples,
+//     P_f[i] = sum_{u,v} w(u) w(v) [ h(front) + (1 - a) (C[2i] + (1 - a) h(back)) ],
+// h = halfSlab; it spans two parents along a, so child samples -1 and 5 are read from the
+// neighbour's children and the transfer skips the face's own axis (svo_transfer_body.glsl).
 // One thread per (node of depth d, sample); pc.args.x = d.
 #include "vct/svo_common.glsl"
 
