@@ -99,8 +99,8 @@ std::vector<uint8_t> cpuLeafOccupancy(const Scene& scene, const VoxelGrid& grid)
 
 }  // namespace
 
-SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid,
-                                     bool anisotropic, DirectionalFilter filter)
+SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid, bool anisotropic,
+                                     DirectionalFilter filter)
     : m_vk(&ctx.vk), m_grid(grid), m_anisotropic(anisotropic), m_filterMode(filter) {
     const uint32_t n = grid.resolution();
     if (!isPowerOfTwo(n))
