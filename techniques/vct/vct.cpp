@@ -83,8 +83,8 @@ TechniqueInfo VctTechnique::describe() {
                   "octree with 3^3 bricks",
                   rebuild),
         boolParam("anisotropic", true,
-                  "dense: 6 directional mip volumes (Crassin §9); off = isotropic mips with the "
-                  "3^3 Gaussian filter",
+                  "6 directional mip volumes (dense) or directional bricks above the leaves "
+                  "(octree) (Crassin §9); off = isotropic mips with the 3^3 Gaussian filter",
                   rebuild),
         intParam("light_map_resolution", 0, 0, 4096, "texels",
                  "light-view map side per light view (0 = auto: texel footprint <= v0/2 on the "
@@ -107,7 +107,8 @@ TechniqueInfo VctTechnique::describe() {
                    "cone radius); -1 = the node-size reading (needs step_factor <= 0.125)"),
         floatParam("lift", 1.5, 0.0, 4.0, "cells",
                    "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane so the "
-                   "surface's own cell is never gathered (0 = off; docs/voxel_cone_tracing.md)"),
+                   "surface's own cell is never gathered (0 = off; the octree adds 0.5 for its "
+                   "vertex-centred samples; docs/voxel_cone_tracing.md)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "",
                    "a cone stops when its accumulated opacity reaches this"),
         boolParam("specular", true,
@@ -295,7 +296,11 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
         glm::vec4(m_grid.origin() + glm::vec3(m_grid.side()), p.getFloat("step_factor"));
     g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
                             p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
-    g.misc = glm::vec4(p.getFloat("lod_offset"), p.getFloat("lift"), 0.0f, 0.0f);
+    // The octree's vertex-centred samples carry a surface's data up to one cell away (not half
+    // a cell as cell-centred voxels do): the same clearance needs half a cell more lift.
+    const float lift = p.getFloat("lift");
+    g.misc = glm::vec4(p.getFloat("lod_offset"), lift > 0.0f && m_octree ? lift + 0.5f : lift,
+                       0.0f, 0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
     g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
