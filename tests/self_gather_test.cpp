@@ -26,8 +26,8 @@ const Image& layer(const std::vector<ImageLayer>& layers, const std::string& nam
 }
 
 struct FloorGather {
-    double indirect = 0.0;          // sum over lit floor pixels (luminance-free: rgb sum)
-    double albedoRadiance = 0.0;    // sum of albedo x direct (the floor's own radiance)
+    double indirect = 0.0;        // sum over lit floor pixels (luminance-free: rgb sum)
+    double albedoRadiance = 0.0;  // sum of albedo x direct (the floor's own radiance)
     int pixels = 0;
     double ratio() const { return albedoRadiance > 0.0 ? indirect / albedoRadiance : 0.0; }
 };

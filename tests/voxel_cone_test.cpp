@@ -658,9 +658,9 @@ TEST_F(GpuVoxelCone, FacingHidesTheBackOfAWall) {
         const glm::vec3 front = g.gridToWorld(glm::vec3(6.0f, 16.0f, 16.0f));
         const glm::vec3 back = g.gridToWorld(glm::vec3(27.0f, 16.0f, 16.0f));
         const std::vector<glm::vec4> r = runner.run({
-            runner.trace(front, {1, 0, 0}, 0.05f, runner.params()),   // base level
+            runner.trace(front, {1, 0, 0}, 0.05f, runner.params()),  // base level
             runner.trace(back, {-1, 0, 0}, 0.05f, runner.params()),
-            runner.trace(front, {1, 0, 0}, 0.3f, runner.params()),    // directional levels
+            runner.trace(front, {1, 0, 0}, 0.3f, runner.params()),  // directional levels
             runner.trace(back, {-1, 0, 0}, 0.3f, runner.params()),
         });
         for (int i : {0, 2}) {

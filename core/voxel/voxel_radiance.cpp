@@ -79,12 +79,11 @@ VoxelRadiance::VoxelRadiance(vk::Context& ctx, const VoxelGrid& grid,
     // base is the source of the first), binding 2 = surface normals (facing weights of the first
     // directional level).
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-    m_setLayout =
-        vk::DescriptorSetLayout(ctx,
-                                {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
-                                 {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
-                                 {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs}},
-                                tag + "/filter");
+    m_setLayout = vk::DescriptorSetLayout(ctx,
+                                          {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                           {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                           {2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs}},
+                                          tag + "/filter");
     m_pipelineLayout =
         vk::PipelineLayout(ctx, {m_setLayout.handle()}, sizeof(FilterPush), cs, tag + "/filter");
     const std::string suffix = options.fullPrecision ? "_f32.comp" : ".comp";

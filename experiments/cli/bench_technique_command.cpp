@@ -71,8 +71,7 @@ void benchOne(vk::Context& ctx, const Scene& scene, const std::string& id,
         std::printf("           set-up %-28s %9.2f ms\n", p.name.c_str(), p.gpuMs);
     for (const std::string& name : order) {
         const Quartiles q = quartiles(passes[name]);
-        std::printf("           frame  %-28s %9.2f ms (IQR %.2f)\n", name.c_str(), q.median,
-                    q.iqr);
+        std::printf("           frame  %-28s %9.2f ms (IQR %.2f)\n", name.c_str(), q.median, q.iqr);
     }
 }
 

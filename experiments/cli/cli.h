@@ -54,9 +54,9 @@ void applyAssignments(const std::vector<std::string>& assignments, ParamSet& tec
 
 /** `gilab bench technique`: set-up and per-frame GPU times of techniques, printed as a table. */
 struct BenchTechniqueOptions {
-    std::string scenePath;                  // "" = the built-in Cornell box
-    std::vector<std::string> techniques;    // default: every registered technique
-    std::vector<std::string> assignments;   // applied to every technique (must exist in each)
+    std::string scenePath;                 // "" = the built-in Cornell box
+    std::vector<std::string> techniques;   // default: every registered technique
+    std::vector<std::string> assignments;  // applied to every technique (must exist in each)
     std::string resolution = "256x256";
     int warmupFrames = 1;
     int frames = 5;

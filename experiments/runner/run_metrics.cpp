@@ -67,7 +67,8 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
             nlohmann::ordered_json entry;
             entry["pixels"] = ro.mask->count();
             // The indirect energy of this region alone (e.g. a surface lit only indirectly)
-            const double regionEnergy = metrics::computeEnergyRatio(indirect, refIndirect, &*ro.mask);
+            const double regionEnergy =
+                metrics::computeEnergyRatio(indirect, refIndirect, &*ro.mask);
             entry["energy_ratio"] =
                 std::isfinite(regionEnergy) ? nlohmann::ordered_json(regionEnergy) : nullptr;
             entry["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, ro));

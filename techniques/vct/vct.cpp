@@ -299,8 +299,8 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
     // The octree's vertex-centred samples carry a surface's data up to one cell away (not half
     // a cell as cell-centred voxels do): the same clearance needs half a cell more lift.
     const float lift = p.getFloat("lift");
-    g.misc = glm::vec4(p.getFloat("lod_offset"), lift > 0.0f && m_octree ? lift + 0.5f : lift,
-                       0.0f, 0.0f);
+    g.misc = glm::vec4(p.getFloat("lod_offset"), lift > 0.0f && m_octree ? lift + 0.5f : lift, 0.0f,
+                       0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
     g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
