@@ -33,7 +33,7 @@ struct ConeTraceParams {
     vec4 distances;    // x max distance (world), y start offset t0 (world), z opacity cutoff,
                        // w AO lambda (1/world units)
     vec4 misc;         // x lod bias (added to the radius level), y lift factor (0 = no lift),
-                       // zw reserved
+                       // z lift rule (0 = cell: 2^ceil(L), 1 = blend), w reserved
 };
 
 // Cone diameter at distance t (notes 003 E6), never below the finest voxel size v0.
@@ -60,6 +60,13 @@ vec3 coneToWorld(vec3 tangentDir, vec3 n) {
 
 bool coneInsideGrid(vec3 p, ConeTraceParams prm) {
     return all(greaterThanEqual(p, prm.gridMinV0.xyz)) && all(lessThanEqual(p, prm.gridMaxStep.xyz));
+}
+
+// The cell size (in v0) the lift clears at level lod: the coarser of the two blended levels,
+// 2^ceil(lod) (the exact rule), or with `blend` the two cell sizes mixed by the level's blend
+// weight, continuous in t (a partial clearance of the coarse cell, weighted as it is sampled).
+float coneLiftCell(float lod, bool blend) {
+    return blend ? mix(exp2(floor(lod)), exp2(ceil(lod)), fract(lod)) : exp2(ceil(lod));
 }
 
 // Distance from p (inside the grid) along unit n to the grid's boundary (0.99 of it).
@@ -121,7 +128,8 @@ void coneMarchStep(inout ConeMarchState st, bool fine, vec3 origin, vec3 dir, fl
         // Notes 001 §2.9: the cell of size v0 2^ceil(L) holding the surface stays out of the
         // trilinear footprint when the sample is >= 1.5 cells above the plane.
         float h = dot(pos - surface.point, surface.normal);
-        float need = liftFactor * exp2(ceil(lod)) - h;
+        bool blend = p.misc.z > 0.5;
+        float need = liftFactor * coneLiftCell(lod, blend) - h;
         if (need > 0.0) {
             // Where the grid ends closer than that along n (an open side of the scene), sample
             // the coarsest level whose lift stays inside instead of empty space.
@@ -129,7 +137,7 @@ void coneMarchStep(inout ConeMarchState st, bool fine, vec3 origin, vec3 dir, fl
             if (need > room) {
                 lod = min(lod, max(floor(log2(max(h + room, 1e-30) / liftFactor)), 0.0));
                 level = exp2(lod);
-                need = min(liftFactor * exp2(ceil(lod)) - h, room);
+                need = min(liftFactor * coneLiftCell(lod, blend) - h, room);
             }
             pos += max(need, 0.0) * surface.normal;
         }

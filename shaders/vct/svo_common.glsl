@@ -1,8 +1,12 @@
 // Declarations of the octree's build and injection passes (techniques/vct/svo.cpp).
 // Set 0: 0 SvoInfo (uniform), 1 node pool, 2 counters (0 nodes, 1 bricks, 2 overflow, 3 -, then
 // per depth d: 4 + 2d first node, 5 + 2d end), 3 occupancy bits (pyramid, one bit per cell),
-// 4 flux accumulators (3 words per leaf brick sample; float bits or fixed point), 5 radiance
-// brick pool, 6 geometry brick pool. Set 1: the voxelizer's albedoOpacity. Set 2: photons.
+// 4 irradiance accumulators (3 words per brick sample, by geometry brick; float bits or fixed
+// point), 5 radiance brick pool, 6 geometry brick pool, 7 per-light photon ranges (8 words per
+// light: 0..2 indirect dispatch x y z, 4 first photon, 5 end; svo_light_ranges.comp), 8 photon
+// deposit counts of the light being splatted (1 word per brick sample), 9 normal brick pool
+// (geometry pool layout, leaves only: xyz unit mean normal, w its length, as the voxelizer's
+// normal volume). Set 1: the voxelizer's albedoOpacity (0) and normal (1). Set 2: photons.
 #ifndef GILAB_VCT_SVO_COMMON_GLSL
 #define GILAB_VCT_SVO_COMMON_GLSL
 
@@ -32,6 +36,18 @@ layout(set = 0, binding = 4, std430) buffer SvoAccum {
 #endif
 layout(set = 0, binding = 5, rgba16f) uniform image3D svoRadiance;
 layout(set = 0, binding = 6, rgba16f) uniform image3D svoGeometry;
+layout(set = 0, binding = 7, std430) buffer SvoLights {
+    uint svoLights[];
+};
+layout(set = 0, binding = 8, std430) buffer SvoCounts {
+    uint svoCount[];
+};
+layout(set = 0, binding = 9, rgba8_snorm) uniform image3D svoNormals;
+
+// Words of light l in svoLights (SparseVoxelOctree::kLightWords per light).
+#define SVO_LIGHT_WORDS 8u
+#define SVO_LIGHT_FIRST 4u
+#define SVO_LIGHT_END 5u
 
 #define SVO_NODE(i) svoNodes[i]
 #define SVO_INFO svo
@@ -50,7 +66,8 @@ layout(set = 0, binding = 6, rgba16f) uniform image3D svoGeometry;
 // x depth, y axis (0..2), z pass / sub-mode, w target (SVO_TARGET_*)
 layout(push_constant, std430) uniform SvoPush {
     uvec4 args;
-    vec4 scale;  // x fixed-point units per W, y W per unit, z 1 / (pi v0^2)
+    vec4 scale;  // x fixed-point units per W/m^2, y W/m^2 per unit, z 1 / pi, w the splatted
+                 // light's irradiance cap per photon (fixed point only)
 } pc;
 
 // Linear thread index of a 1D launch recorded as a 2D grid (SparseVoxelOctree::dispatchGroups:

@@ -23,8 +23,13 @@
 //     P_f[i] = sum_{u,v} w(u) w(v) [ h(front) + (1 - a) (C[2i] + (1 - a) h(back)) ],
 // h = halfSlab; it spans two parents along a, so child samples -1 and 5 are read from the
 // neighbour's children and the transfer skips the face's own axis (svo_transfer_body.glsl).
+// Facing (Crassin §7, common/voxel_facing.glsl; as the dense first directional level,
+// voxel_radiance_aniso_body.glsl): at level D - 1 each leaf child sample's colour is weighted by
+// voxelFacing(its mean normal, the face's travel direction) before compositing (opacity kept),
+// so a lit surface shines only toward its front in every directional brick above the leaves.
 // One thread per (node of depth d, sample); pc.args.x = d.
 #include "vct/svo_common.glsl"
+#include "common/voxel_facing.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
 
@@ -38,12 +43,16 @@ float axisWeight(int c, int i) {
 uint gNode;
 uint gChild;
 bool gLeafChildren;
+const vec3 kFaceTravel[6] = vec3[6](vec3(-1, 0, 0), vec3(1, 0, 0), vec3(0, -1, 0), vec3(0, 1, 0),
+                                    vec3(0, 0, -1), vec3(0, 0, 1));
 
 // Child-level sample at parent-local coordinate c of the source of face f: c in 0..4 per axis
 // inside this node's children (copies shared by two children agree after their transfer, so
 // child min(c / 2, 1) is read); c = -1 or 5 along one axis (slab filter only) lies in the
 // children of the neighbouring node on that side.
-vec4 childSample(ivec3 c, uint f) {
+// Leaf children (gLeafChildren) also return the sample's mean normal m (xyz * length).
+vec4 childSample(ivec3 c, uint f, out vec3 m) {
+    m = vec3(0.0);
     uint child = gChild;
     for (int ax = 0; ax < 3; ++ax) {
         if (c[ax] < 0 || c[ax] > 4) {
@@ -55,10 +64,27 @@ vec4 childSample(ivec3 c, uint f) {
     }
     if (child == 0u) return vec4(0.0);
     ivec3 o = min(c >> 1, ivec3(1));
-    uint slot = svoWord(child + uint(o.x + 2 * o.y + 4 * o.z), SVO_W_RADIANCE);
+    uint node = child + uint(o.x + 2 * o.y + 4 * o.z);
+    uint slot = svoWord(node, SVO_W_RADIANCE);
     if (slot == SVO_NONE) return vec4(0.0);
     uint s = gLeafChildren ? slot : slot + f;
+    if (gLeafChildren) {
+        uint brick = svoWord(node, SVO_W_BRICK);
+        if (brick != SVO_NONE)
+            m = voxelMeanNormal(imageLoad(svoNormals, svoBrickOrigin(brick) + c - 2 * o));
+    }
     return max(imageLoad(svoRadiance, svoRadianceOrigin(s) + c - 2 * o), vec4(0.0));
+}
+
+vec4 nbh[27];    // child samples 2i - 1 + n (n = 0..2 per axis)
+vec3 nbhM[27];   // their mean normals (leaf children only)
+
+// Neighbourhood sample n as seen by rays of face f: leaf colours facing-weighted, opacity kept.
+vec4 facedSample(ivec3 m, uint f) {
+    int n = m.x + 3 * (m.y + 3 * m.z);
+    vec4 v = nbh[n];
+    if (gLeafChildren) v.rgb *= voxelFacing(nbhM[n], kFaceTravel[f]);
+    return v;
 }
 
 vec4 composite(vec4 front, vec4 back) { return front + (1.0 - clamp(front.a, 0.0, 1.0)) * back; }
@@ -86,7 +112,6 @@ void main() {
     bool slab = svo.radiance.w == SVO_ANISO_SLAB;
     // Child samples 2i - 1 + n (n = 0..2 per axis); outside the node's children: zero (pairs)
     // or, along the face's axis, the neighbour's (slab).
-    vec4 nbh[27];
     for (uint f = 0u; f < 6u; ++f) {
         int axis = int(f >> 1);
         if (f == 0u || !gLeafChildren || (slab && (f & 1u) == 0u)) {
@@ -97,7 +122,9 @@ void main() {
                 ivec3 cc = clamp(c, ivec3(0), ivec3(4));
                 cc[axis] = c[axis];
                 bool along = all(equal(cc, c));  // outside only along the face's axis
-                nbh[n] = (inside || (slab && along)) ? childSample(c, f) : vec4(0.0);
+                vec3 normal = vec3(0.0);
+                nbh[n] = (inside || (slab && along)) ? childSample(c, f, normal) : vec4(0.0);
+                nbhM[n] = normal;
             }
         }
         bool towardPositive = (f & 1u) != 0u;  // +X: rays enter the smaller coordinate first
@@ -116,9 +143,9 @@ void main() {
                 ivec3 m0 = m, m1 = m, m2 = m;
                 m1[axis] = 1;
                 m2[axis] = 2;
-                vec4 lo = nbh[m0.x + 3 * (m0.y + 3 * m0.z)];   // child sample 2i - 1
-                vec4 mid = nbh[m1.x + 3 * (m1.y + 3 * m1.z)];  // 2i
-                vec4 hi = nbh[m2.x + 3 * (m2.y + 3 * m2.z)];   // 2i + 1
+                vec4 lo = facedSample(m0, f);   // child sample 2i - 1
+                vec4 mid = facedSample(m1, f);  // 2i
+                vec4 hi = facedSample(m2, f);   // 2i + 1
                 if (slab) {
                     // One integration step through the footprint 2i-1 .. 2i+1 (half slabs at the
                     // ends, shared with the neighbouring parent samples).

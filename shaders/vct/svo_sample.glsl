@@ -7,9 +7,14 @@
 // anisotropic octree: per axis the directional brick chosen by the sign of `dir` (dir.x < 0 ->
 // -X, rays travelling toward -x), weighted by dir^2 / |dir|^2, as the dense sampler
 // (voxelConeDirectional in common/voxel_cone_dense.glsl); so lod < 1 blends the isotropic leaf
-// level with the first directional level. Isotropic octree: `dir` is unused.
+// level with the first directional level. Facing (Crassin §7, common/voxel_facing.glsl, as the
+// dense base samples): a leaf-level sample's colour is weighted by voxelFacing of the trilinear
+// normal brick sample divided by the trilinear coverage (voxelMeanNormalFiltered), opacity kept;
+// the directional levels are built facing-weighted (svo_filter_aniso.comp). Isotropic octree:
+// facing at the leaf level only, `dir` is unused above it.
 // Before including, define SVO_SET and SVO_BINDING (layout as
-// SparseVoxelOctree::addLayoutBindings: +0 SvoInfo uniform, +1 node pool, +2 radiance bricks).
+// SparseVoxelOctree::addLayoutBindings: +0 SvoInfo uniform, +1 node pool, +2 radiance bricks,
+// +3 leaf normal bricks).
 #ifndef GILAB_VCT_SVO_SAMPLE_GLSL
 #define GILAB_VCT_SVO_SAMPLE_GLSL
 
@@ -26,15 +31,23 @@ layout(set = SVO_SET, binding = SVO_BINDING + 1, std430) readonly buffer SvoSamp
     uint svoSampleNodes[];
 };
 layout(set = SVO_SET, binding = SVO_BINDING + 2) uniform sampler3D svoRadiancePool;
+layout(set = SVO_SET, binding = SVO_BINDING + 3) uniform sampler3D svoNormalPool;
 
 #define SVO_NODE(i) svoSampleNodes[i]
 #define SVO_INFO svoInfo
 #include "vct/svo_tree.glsl"
+#include "common/voxel_facing.glsl"
 
 // Trilinear lookup at `local` (0..2 per axis) in radiance brick `slot`.
 vec4 svoFetch(uint slot, vec3 local) {
     vec3 texel = vec3(svoRadianceOrigin(slot)) + 0.5 + local;
     return textureLod(svoRadiancePool, texel / vec3(textureSize(svoRadiancePool, 0)), 0.0);
+}
+
+// Trilinear lookup at `local` in the normal brick of geometry brick `brick` (leaves).
+vec4 svoFetchNormal(uint brick, vec3 local) {
+    vec3 texel = vec3(svoBrickOrigin(brick)) + 0.5 + local;
+    return textureLod(svoNormalPool, texel / vec3(textureSize(svoNormalPool, 0)), 0.0);
 }
 
 // Level l sample (spacing v0 2^l) at grid position g (voxel units, centres at i + 0.5) for a
@@ -53,7 +66,14 @@ vec4 svoSampleLevel(vec3 g, uint level, vec3 dir) {
     uint slot = svoWord(node, SVO_W_RADIANCE);
     if (slot == SVO_NONE) return vec4(0.0);
     vec3 local = clamp(u - 2.0 * vec3(cell), vec3(0.0), vec3(2.0));
-    if (level == 0u || !svoAnisotropic()) return svoFetch(slot, local);
+    if (level == 0u) {
+        vec4 s = svoFetch(slot, local);
+        uint brick = svoWord(node, SVO_W_BRICK);
+        if (brick != SVO_NONE)
+            s.rgb *= voxelFacing(voxelMeanNormalFiltered(svoFetchNormal(brick, local), s.a), dir);
+        return s;
+    }
+    if (!svoAnisotropic()) return svoFetch(slot, local);
     vec3 w = dir * dir;
     float wsum = w.x + w.y + w.z;
     if (!(wsum > 1e-12)) return vec4(0.0);

@@ -1,7 +1,7 @@
-// Leaf shading after the flux transfer (the dense path's formula, spec "Shared data
-// conventions"): rgb = a albedo / pi * sum(flux) / v0^2 (premultiplied outgoing diffuse
-// radiance), a = coverage, from the geometry brick (a albedo, a), written to the leaf's radiance
-// slot. One thread per leaf sample.
+// Leaf shading after the irradiance transfer (the dense path's formula, inject_shade_body.glsl):
+// rgb = a albedo / pi * E (premultiplied outgoing diffuse radiance; E = sum over lights of the
+// light's mean photon irradiance, svo_splat_body.glsl), a = coverage, from the geometry brick
+// (a albedo, a), written to the leaf's radiance slot. One thread per leaf sample.
 #include "vct/svo_common.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;
@@ -20,11 +20,12 @@ void main() {
     vec4 g = imageLoad(svoGeometry, svoBrickOrigin(brick) + s);
     uint base = (brick * 27u + k) * 3u;
 #ifdef SVO_FLOAT_ACCUM
-    vec3 flux = vec3(svoAccum[base], svoAccum[base + 1u], svoAccum[base + 2u]);
+    vec3 e = vec3(svoAccum[base], svoAccum[base + 1u], svoAccum[base + 2u]);
 #else
-    vec3 flux = vec3(svoAccum[base], svoAccum[base + 1u], svoAccum[base + 2u]) * pc.scale.y;
+    vec3 e = vec3(svoAccum[base], svoAccum[base + 1u], svoAccum[base + 2u]) * pc.scale.y;
 #endif
-    flux = max(flux, vec3(0.0));
-    vec3 rgb = g.a > 0.0 ? g.rgb * flux * pc.scale.z : vec3(0.0);
+    e = max(e, vec3(0.0));
+    // RGBA16F saturates at 65504: clamp there rather than store Inf (as the dense shade)
+    vec3 rgb = g.a > 0.0 ? min(g.rgb * e * pc.scale.z, vec3(65504.0)) : vec3(0.0);
     imageStore(svoRadiance, svoRadianceOrigin(slot) + s, vec4(rgb, g.a));
 }

@@ -1,9 +1,27 @@
-// Photon splat into the octree's leaves (Crassin §8.2, notes 001 §2.5): one thread per photon.
-// Like the dense splat (vct/splat_dense_body.glsl), the photon's flux goes to the voxel s that
-// holds it, i.e. the lattice sample s (its centre); the leaf cell floor(s / 2) is found by
-// descending from the root and the flux is added atomically to that brick's copy of the sample
-// (local index s - 2 floor(s / 2) in {0, 1}). svo_transfer then adds the duplicated copies.
-// An uncovered voxel (round-off at a face) is retried half a voxel toward / away from the light.
+// Photon splat into the octree's leaves (Crassin §8.2, notes 001 §2.5; docs/vct_svo.md
+// "Injection"): the dense path's rule (vct/splat_dense_body.glsl) on the leaf lattice. Launched
+// once per light l = pc.args.x with an indirect dispatch over the light's photon range
+// (svo_light_ranges.comp), in two modes (pc.args.z):
+//   SVO_SPLAT_COUNT: every deposit of the light's photons adds 1 to its sample's count;
+//   SVO_SPLAT_IRRADIANCE: every deposit adds E / count (E the photon's irradiance),
+// so each leaf sample ends up with this light's mean irradiance over its deposits, summed over
+// the lights (the counts are cleared before each light). Exact for a plane at any orientation.
+//
+// Deposits: the photon's footprint on its tangent plane is cut into kx x ky cells of at most
+// v0 / 2 per side; every covered voxel that the plane crosses within a cell's half-diagonal of a
+// cell centre gets one deposit (as the dense splat). The footprint comes from the photon alone
+// (the octree gets no light views): its area is flux / E (the texel's flux over the irradiance it
+// produces, exact for pinhole and orthographic texels), its shape a square of side w = sqrt(A
+// cos) across the light direction projected onto the plane: w / cos along the light's tangent
+// direction, w across it (the texel's rotation about the ray is not known; the cells overlap
+// their neighbours' by the deposit radius, so the union still reaches every crossed voxel).
+// Photons with E = 0 (a spot's falloff, back-facing, misses) deposit nothing and count nothing.
+//
+// Where a deposit goes: voxel s is lattice sample s of the leaves (its centre); it has 1, 2, 4 or
+// 8 brick copies, and the canonical one is in leaf cell floor(s / 2) (local index s - 2 floor(s /
+// 2) in {0, 1}, a leaf that exists whenever voxel s is covered). Both modes write only that copy,
+// so the count read by the irradiance pass is complete without a transfer; afterwards the other
+// copies hold 0 and svo_transfer's add / copy passes give every copy the canonical sum.
 #include "vct/svo_common.glsl"
 
 layout(set = 2, binding = 0, std430) readonly buffer Photons {
@@ -11,53 +29,125 @@ layout(set = 2, binding = 0, std430) readonly buffer Photons {
 };
 layout(local_size_x = SVO_GROUP_SIZE) in;
 
-// Leaf node and brick holding sample s, or SVO_NONE; brick sample covered (geometry a > 0).
-uint leafBrickOf(ivec3 s, out ivec3 local, out bool covered) {
-    covered = false;
-    local = ivec3(0);
-    if (any(lessThan(s, ivec3(0))) || any(greaterThanEqual(s, ivec3(svo.dims.x)))) return SVO_NONE;
+#define SVO_SPLAT_COUNT 0u
+#define SVO_SPLAT_IRRADIANCE 1u
+
+const int kMaxCellsPerEdge = 16;
+const int kMaxCells = 64;
+
+// One-entry cache of the last leaf looked up (a photon's deposits fall in a few leaves).
+uvec3 gCell = uvec3(0xFFFFFFFFu);
+uint gBrick = SVO_NONE;
+
+// Canonical accumulator index (brick * 27 + local sample) of voxel s if it is covered, else -1.
+int coveredSample(ivec3 s) {
+    if (any(lessThan(s, ivec3(0))) || any(greaterThanEqual(s, ivec3(svo.dims.x)))) return -1;
     uvec3 cell = uvec3(s >> 1);
-    uint node = svoFindNode(cell, svo.dims.y);
-    if (node == SVO_NONE) return SVO_NONE;
-    uint brick = svoWord(node, SVO_W_BRICK);
-    if (brick == SVO_NONE) return SVO_NONE;
-    local = s - 2 * ivec3(cell);
-    covered = imageLoad(svoGeometry, svoBrickOrigin(brick) + local).a > 0.0;
-    return brick;
+    if (cell != gCell) {
+        gCell = cell;
+        uint node = svoFindNode(cell, svo.dims.y);
+        gBrick = node == SVO_NONE ? SVO_NONE : svoWord(node, SVO_W_BRICK);
+    }
+    if (gBrick == SVO_NONE) return -1;
+    ivec3 local = s - 2 * ivec3(cell);
+    if (!(imageLoad(svoGeometry, svoBrickOrigin(gBrick) + local).a > 0.0)) return -1;
+    return int(gBrick * 27u + uint(svoSampleIndex(local)));
 }
 
-void main() {
-    uint i = svoThread();
-    if (i >= pc.args.x) return;
-    Photon p = photons[i];
-    if (p.positionValid.w < 0.5) return;
-    float v0 = svo.originVoxelSize.w;
-    vec3 origin = svo.originVoxelSize.xyz;
-    ivec3 local;
-    bool covered;
-    ivec3 s = ivec3(floor((p.positionValid.xyz - origin) / v0));
-    uint brick = leafBrickOf(s, local, covered);
-    if (!covered) {
-        for (int k = 0; k < 2 && !covered; ++k) {
-            vec3 q = p.positionValid.xyz + (k == 0 ? 0.5 : -0.5) * v0 * p.toLight.xyz;
-            ivec3 s2 = ivec3(floor((q - origin) / v0));
-            ivec3 local2;
-            uint b2 = leafBrickOf(s2, local2, covered);
-            if (covered) {
-                brick = b2;
-                local = local2;
-            }
-        }
-    }
-    if (brick == SVO_NONE) return;
-    vec3 flux = max(p.flux.rgb, vec3(0.0));
-    uint base = (brick * 27u + uint(svoSampleIndex(local))) * 3u;
+void addIrradiance(uint base, vec3 e) {
 #ifdef SVO_FLOAT_ACCUM
     for (uint ch = 0u; ch < 3u; ++ch)
-        if (flux[ch] != 0.0) atomicAdd(svoAccum[base + ch], flux[ch]);
+        if (e[ch] != 0.0) atomicAdd(svoAccum[base + ch], e[ch]);
 #else
-    uvec3 q = uvec3(round(flux * pc.scale.x));
+    uvec3 q = uvec3(round(e * pc.scale.x));
     for (uint ch = 0u; ch < 3u; ++ch)
         if (q[ch] != 0u) atomicAdd(svoAccum[base + ch], q[ch]);
 #endif
+}
+
+// Deposits at grid point g (on the tangent plane of normal n) into every covered voxel that the
+// plane crosses within rg (grid units, <= 1/2: at most 2 voxels per axis) of g.
+void deposit(vec3 g, vec3 n, float rg, vec3 e, bool countMode) {
+    ivec3 lo = ivec3(floor(g - rg));
+    ivec3 hi = ivec3(floor(g + rg));
+    float halfExtent = 0.5 * (abs(n.x) + abs(n.y) + abs(n.z)) + 1e-4;
+    for (int z = lo.z; z <= hi.z; ++z) {
+        for (int y = lo.y; y <= hi.y; ++y) {
+            for (int x = lo.x; x <= hi.x; ++x) {
+                ivec3 c = ivec3(x, y, z);
+                if (abs(dot(n, vec3(c) + 0.5 - g)) > halfExtent) continue;
+                vec3 d = max(max(vec3(c) - g, g - vec3(c + 1)), vec3(0.0));
+                if (dot(d, d) > rg * rg) continue;
+                int index = coveredSample(c);
+                if (index < 0) continue;
+                if (countMode) {
+                    atomicAdd(svoCount[index], 1u);
+                } else {
+                    uint count = svoCount[index];
+                    if (count > 0u) addIrradiance(uint(index) * 3u, e / float(count));
+                }
+            }
+        }
+    }
+}
+
+void main() {
+    uint light = pc.args.x;
+    uint base = light * SVO_LIGHT_WORDS;
+    uint i = svoLights[base + SVO_LIGHT_FIRST] + svoThread();
+    if (i >= svoLights[base + SVO_LIGHT_END]) return;
+    Photon p = photons[i];
+    if (p.positionValid.w < 0.5 || p.normal.w < 0.5) return;  // miss, or faces away
+    if (abs(p.irradiance.w - float(light)) > 0.25) return;   // another light's photon
+    vec3 e = max(p.irradiance.rgb, vec3(0.0));
+    vec3 flux = max(p.flux.rgb, vec3(0.0));
+    float eMax = max(e.r, max(e.g, e.b));
+    float fluxMax = max(flux.r, max(flux.g, flux.b));
+    if (!(eMax > 0.0) || !(fluxMax > 0.0)) return;
+#ifndef SVO_FLOAT_ACCUM
+    if (pc.scale.w > 0.0) e = min(e, vec3(pc.scale.w));
+#endif
+    bool countMode = pc.args.z == SVO_SPLAT_COUNT;
+    float v0 = svo.originVoxelSize.w;
+    vec3 n = p.normal.xyz;
+    vec3 l = p.toLight.xyz;
+
+    // Footprint (world): area A = flux / E; a square of side w across the light direction,
+    // projected along it onto the tangent plane
+    float area = fluxMax / eMax;
+    float cosTheta = clamp(dot(n, l), 1e-3, 1.0);
+    vec3 t = l - n * dot(n, l);
+    float tl = length(t);
+    if (tl > 1e-5) {
+        t /= tl;
+    } else {
+        vec3 guide = abs(n.z) < 0.9 ? vec3(0.0, 0.0, 1.0) : vec3(1.0, 0.0, 0.0);
+        t = normalize(cross(guide, n));
+    }
+    float w = sqrt(area * cosTheta);
+    vec3 ex = t * (w / cosTheta);
+    vec3 ey = cross(n, t) * w;
+
+    // Cells of at most v0 / 2 per side; very long footprints (grazing) are clipped
+    float cell = 0.5 * v0;
+    float maxEdge = float(kMaxCellsPerEdge) * cell;
+    float lx = length(ex), ly = length(ey);
+    if (lx > maxEdge) ex *= maxEdge / lx;
+    if (ly > maxEdge) ey *= maxEdge / ly;
+    int kx = clamp(int(ceil(min(lx, maxEdge) / cell)), 1, kMaxCellsPerEdge);
+    int ky = clamp(int(ceil(min(ly, maxEdge) / cell)), 1, kMaxCellsPerEdge);
+    while (kx * ky > kMaxCells) {
+        if (kx >= ky) kx = (kx + 1) / 2; else ky = (ky + 1) / 2;
+    }
+    vec3 cx = ex / float(kx), cy = ey / float(ky);
+    float r = clamp(0.5 * max(length(cx + cy), length(cx - cy)), 0.1 * v0, 0.5 * v0);
+
+    vec3 g0 = (p.positionValid.xyz - svo.originVoxelSize.xyz) / v0;
+    for (int b = 0; b < ky; ++b) {
+        for (int a = 0; a < kx; ++a) {
+            vec3 q = ((float(a) + 0.5) / float(kx) - 0.5) * ex +
+                     ((float(b) + 0.5) / float(ky) - 0.5) * ey;
+            deposit(g0 + q / v0, n, r / v0, e, countMode);
+        }
+    }
 }

@@ -53,6 +53,9 @@ std::vector<ParamSpec> dvsParamSpecs() {
         floatParam("lift", 1.5, 0.0, 4.0, "cells",
                    "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane (no "
                    "self-gather; 0 = off; docs/voxel_cone_tracing.md)"),
+        enumParam("lift_rule", "cell", {"cell", "blend"},
+                  "cell: clear the coarser blended level's cell 2^ceil(L) (exact); blend: the two "
+                  "cell sizes mixed by the level weight (continuous in t)"),
         floatParam("origin_offset", 2.0, 0.0, 8.0, "voxels",
                    "cone origin offset along the normal, and first step (repo 2)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "", "stop a cone at this opacity"),
@@ -93,6 +96,7 @@ DvsSettings dvsSettingsFrom(const ParamSet& p) {
     s.maxDistance = p.getFloat("max_distance");
     s.lodOffset = p.getFloat("lod_offset");
     s.lift = p.getFloat("lift");
+    s.liftBlend = p.getEnum("lift_rule") == "blend";
     s.originOffset = p.getFloat("origin_offset");
     s.opacityCutoff = p.getFloat("opacity_cutoff");
     return s;

@@ -38,6 +38,7 @@ struct DvsSettings {
     float maxDistance = 0.95f;  // grid sides
     float lodOffset = 0.0f;     // added to the radius level (Crassin §5; -1 = node-size reading)
     float lift = 1.5f;          // sample lift above the surface plane, cells (voxel_cone.glsl)
+    bool liftBlend = false;     // lift_rule = blend
     float originOffset = 2.0f;  // voxels along the normal (and first step along the cone)
     float opacityCutoff = 0.99f;
 };

@@ -95,8 +95,9 @@ void DvsPixelTrace::record(VkCommandBuffer cmd, const DvsSettings& s, const Came
     TraceUniforms u{};
     u.grid = grid.gpu();
     // t0: the same offset again along the cone (repo: x + n s + d t, t from s), at least v0.
-    u.cone = makeConeTraceParams(grid, s.stepFactor, s.maxDistance * grid.side(),
-                                 std::max(offset, v0), s.opacityCutoff, 0.0f, s.lodOffset, s.lift);
+    u.cone =
+        makeConeTraceParams(grid, s.stepFactor, s.maxDistance * grid.side(), std::max(offset, v0),
+                            s.opacityCutoff, 0.0f, s.lodOffset, s.lift, s.liftBlend);
     u.diffuse = toGpu(diffuse);
     u.camera = glm::vec4(camera.position, offset);
     u.specular = glm::vec4(s.specular ? 1.0f : 0.0f,

@@ -98,7 +98,7 @@ DvsVoxelLighting::DvsVoxelLighting(vk::Context& ctx, Voxelizer& voxelizer, Voxel
     const DvsSettings& s = settings;
     u.cone = makeConeTraceParams(grid, s.stepFactor, s.maxDistance * grid.side(),
                                  std::max(s.originOffset * v0, v0), s.opacityCutoff, 0.0f,
-                                 s.lodOffset, s.lift);
+                                 s.lodOffset, s.lift, s.liftBlend);
     u.misc = glm::vec4(s.originOffset * v0, 0.0f, 0.0f, 0.0f);
     u.cones = toGpu(cones);
     m_bounceUniforms = vk::Buffer(ctx, sizeof(BounceUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,

@@ -5,10 +5,13 @@
 #include <numbers>
 #include <string>
 
+#include "core/passes/shadow_maps.h"
+#include "core/passes/shared_passes.h"
 #include "core/scene/scene.h"
 #include "core/util/error.h"
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
+#include "techniques/vct/light_injection.h"
 
 namespace gilab::vct {
 namespace {
@@ -18,9 +21,10 @@ constexpr uint32_t kCounterWords = 4 + 2 * 16;  // nodes, bricks, overflow, radi
 constexpr VkShaderStageFlags kCs = VK_SHADER_STAGE_COMPUTE_BIT;
 
 struct Push {
-    glm::uvec4 args{0};  // x depth, y axis, z pass, w target
-    glm::vec4 scale{0};  // x units per W, y W per unit, z 1 / (pi v0^2)
+    glm::uvec4 args{0};  // x depth, y axis, z pass, w target (splat: x light, z mode)
+    glm::vec4 scale{0};  // x units per W/m^2, y W/m^2 per unit, z 1 / pi, w irradiance cap
 };
+constexpr uint32_t kSplatCount = 0, kSplatIrradiance = 1;  // SVO_SPLAT_* (svo_splat_body.glsl)
 
 // Targets of the transfer / filter passes (SVO_TARGET_* in svo_common.glsl).
 enum Target : uint32_t { kAccum = 0, kRadiance = 1, kGeometry = 2, kDirectional = 3 };
@@ -100,15 +104,36 @@ std::vector<uint8_t> cpuLeafOccupancy(const Scene& scene, const VoxelGrid& grid)
 }  // namespace
 
 SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& grid, bool anisotropic,
-                                     DirectionalFilter filter)
+                                     DirectionalFilter filter, bool floatAtomics)
     : m_vk(&ctx.vk), m_grid(grid), m_anisotropic(anisotropic), m_filterMode(filter) {
     const uint32_t n = grid.resolution();
     if (!isPowerOfTwo(n))
         throw Error("resolution: the sparse voxel octree needs a power of two, got " +
                     std::to_string(n));
     m_leafDepth = log2u(n / 2);
-    m_floatAtomics = ctx.vk.hasFloatAtomics();
+    m_floatAtomics = floatAtomics && ctx.vk.hasFloatAtomics();
     const uint32_t depthCount = m_leafDepth + 1;
+
+    // Lights as LightInjection numbers them (photon irradiance.w), and the fixed-point scale of
+    // the irradiance sums as the dense path: each light's photon E is clamped to its cap (E at
+    // v0 / 2 from a pinhole light, E_perp for directional), the caps' sum fits 2^31 units.
+    {
+        const std::vector<GpuLightView> views =
+            buildLightViews(ctx.scene, grid, ctx.shared.shadows().emitterSamples());
+        m_lightCount = views.empty() ? 1u : views.back().group.x + 1u;
+        m_irradianceCaps.assign(m_lightCount, 0.0f);
+        const double rCap = 0.5 * double(grid.voxelSize());
+        for (const GpuLightView& v : views) {
+            const double i = std::max({v.intensity.x, v.intensity.y, v.intensity.z});
+            const double cap = v.positionKind.w > 0.5f ? i : i / (rCap * rCap);
+            float& c = m_irradianceCaps[v.group.x];
+            c = float(std::max(double(c), cap));
+        }
+        double bound = 0.0;
+        for (float c : m_irradianceCaps)
+            bound += double(c);
+        if (bound > 0.0) m_fixedScale = 2.0e9 / bound;
+    }
 
     // Pool sizing from the CPU occupancy pyramid (same rule as svo_occupancy_up.comp).
     std::vector<std::vector<uint8_t>> occ(depthCount);
@@ -198,7 +223,12 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     m_counters = vk::Buffer(vk, kCounterWords * 4, storage, vk::MemoryUsage::DeviceLocal,
                             ctx.tag("svo/counters"));
     m_accum = vk::Buffer(vk, VkDeviceSize(m_brickCapacity) * kBrickSamples * 3 * 4, storage,
-                         vk::MemoryUsage::DeviceLocal, ctx.tag("svo/flux_accumulators"));
+                         vk::MemoryUsage::DeviceLocal, ctx.tag("svo/irradiance_accumulators"));
+    m_count = vk::Buffer(vk, VkDeviceSize(m_brickCapacity) * kBrickSamples * 4, storage,
+                         vk::MemoryUsage::DeviceLocal, ctx.tag("svo/photon_counts"));
+    m_lights = vk::Buffer(vk, VkDeviceSize(m_lightCount) * kLightWords * 4,
+                          storage | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT,
+                          vk::MemoryUsage::DeviceLocal, ctx.tag("svo/light_ranges"));
     m_occupancy = vk::Buffer(vk, VkDeviceSize(std::max(occWords, 1u)) * 4, storage,
                              vk::MemoryUsage::DeviceLocal, ctx.tag("svo/occupancy"));
     vk::ImageDesc desc;
@@ -215,6 +245,9 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     desc.depth = 3 * gb.z;
     desc.name = ctx.tag("svo/geometry_bricks");
     m_geometry = vk::Image(vk, desc);
+    desc.format = VK_FORMAT_R8G8B8A8_SNORM;
+    desc.name = ctx.tag("svo/normal_bricks");
+    m_normals = vk::Image(vk, desc);
     vk::SamplerDesc sd;
     sd.filter = VK_FILTER_LINEAR;
     sd.mipmap = VK_SAMPLER_MIPMAP_MODE_NEAREST;
@@ -233,10 +266,15 @@ void SparseVoxelOctree::createPipelines() {
                                            {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs},
                                            {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs},
                                            {5, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kCs},
-                                           {6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kCs}},
+                                           {6, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kCs},
+                                           {7, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs},
+                                           {8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs},
+                                           {9, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kCs}},
                                           "vct/svo");
-    m_voxelLayout = vk::DescriptorSetLayout(
-        vk, {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs}}, "vct/svo_voxels");
+    m_voxelLayout = vk::DescriptorSetLayout(vk,
+                                            {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs},
+                                             {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs}},
+                                            "vct/svo_voxels");
     m_photonLayout = vk::DescriptorSetLayout(vk, {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs}},
                                              "vct/svo_photons");
     m_set = vk::DescriptorSet(vk, m_setLayout, 0, "vct/svo");
@@ -247,6 +285,9 @@ void SparseVoxelOctree::createPipelines() {
     m_set.writeBuffer(4, m_accum);
     m_set.writeStorageImage(5, m_radiance.view());
     m_set.writeStorageImage(6, m_geometry.view());
+    m_set.writeBuffer(7, m_lights);
+    m_set.writeBuffer(8, m_count);
+    m_set.writeStorageImage(9, m_normals.view());
     m_voxelSet = vk::DescriptorSet(vk, m_voxelLayout, 0, "vct/svo_voxels");
     m_photonSet = vk::DescriptorSet(vk, m_photonLayout, 0, "vct/svo_photons");
     m_layout = vk::PipelineLayout(
@@ -263,11 +304,11 @@ void SparseVoxelOctree::createPipelines() {
     m_splat = make(m_floatAtomics ? "vct/svo_splat_float.comp" : "vct/svo_splat.comp");
     m_transfer = make(m_floatAtomics ? "vct/svo_transfer_float.comp" : "vct/svo_transfer.comp");
     m_shade = make(m_floatAtomics ? "vct/svo_shade_float.comp" : "vct/svo_shade.comp");
+    m_lightRanges = make("vct/svo_light_ranges.comp");
 }
 
-void SparseVoxelOctree::bindAndDispatch(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline,
-                                        const glm::uvec4& args, uint32_t threads, bool voxelSet,
-                                        bool photonSet) const {
+void SparseVoxelOctree::bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline,
+                             bool voxelSet, bool photonSet) const {
     pipeline.bind(cmd);
     VkDescriptorSet set0 = m_set.handle();
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout.handle(), 0, 1, &set0, 0,
@@ -282,12 +323,21 @@ void SparseVoxelOctree::bindAndDispatch(VkCommandBuffer cmd, const vk::ComputePi
         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_layout.handle(), 2, 1, &s, 0,
                                 nullptr);
     }
+}
+
+void SparseVoxelOctree::push(VkCommandBuffer cmd, const glm::uvec4& args, float cap) const {
     Push push;
     push.args = args;
-    const float v0 = m_grid.voxelSize();
-    push.scale = glm::vec4(float(m_fixedScale), float(1.0 / m_fixedScale), 0.0f, 0.0f);
-    push.scale.z = 1.0f / (std::numbers::pi_v<float> * v0 * v0);
+    push.scale = glm::vec4(float(m_fixedScale), float(1.0 / m_fixedScale),
+                           1.0f / std::numbers::pi_v<float>, cap);
     m_layout.push(cmd, push);
+}
+
+void SparseVoxelOctree::bindAndDispatch(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline,
+                                        const glm::uvec4& args, uint32_t threads, bool voxelSet,
+                                        bool photonSet) const {
+    bind(cmd, pipeline, voxelSet, photonSet);
+    push(cmd, args);
     dispatch(cmd, threads);
 }
 
@@ -337,12 +387,17 @@ void SparseVoxelOctree::build(TechniqueContext& ctx, VkCommandBuffer cmd, VoxelV
     PassScope pass(ctx, cmd, "svo_build");
     if (voxels.albedoOpacity.layout() != VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
         voxels.albedoOpacity.transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
-    if (m_voxelView != voxels.albedoOpacity.view()) {
+    if (voxels.normal.layout() != VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL)
+        voxels.normal.transition(cmd, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL);
+    if (m_voxelView != voxels.albedoOpacity.view() || m_normalView != voxels.normal.view()) {
         m_voxelView = voxels.albedoOpacity.view();
+        m_normalView = voxels.normal.view();
         m_voxelSet.writeSampledImage(0, m_voxelView, m_sampler.handle());
+        m_voxelSet.writeSampledImage(1, m_normalView, m_sampler.handle());
     }
     m_radiance.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
     m_geometry.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
+    m_normals.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
     vkCmdFillBuffer(cmd, m_counters.handle(), 0, VK_WHOLE_SIZE, 0);
     vkCmdFillBuffer(cmd, m_occupancy.handle(), 0, VK_WHOLE_SIZE, 0);
     vk::memoryBarrier(cmd);
@@ -394,11 +449,31 @@ void SparseVoxelOctree::inject(TechniqueContext& ctx, VkCommandBuffer cmd,
         m_photonSet.writeBuffer(0, *photons.buffer);
     }
     {
+        // docs/vct_svo.md "Injection": each light's photon range, then per light the deposit
+        // counts and the mean irradiance (E / count per deposit) into the canonical leaf copies.
         PassScope pass(ctx, cmd, "svo_inject");
         vkCmdFillBuffer(cmd, m_accum.handle(), 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(cmd, m_lights.handle(), 0, VK_WHOLE_SIZE, 0);
         vk::memoryBarrier(cmd);
-        bindAndDispatch(cmd, m_splat, {photons.count, 0, 0, 0}, photons.count, false, true);
+        bindAndDispatch(cmd, m_lightRanges, {photons.count, m_lightCount, 0, m_maxGroups.x},
+                        photons.count, false, true);
         vk::memoryBarrier(cmd);
+        bindAndDispatch(cmd, m_lightRanges, {photons.count, m_lightCount, 1, m_maxGroups.x},
+                        m_lightCount, false, true);
+        vk::memoryBarrier(cmd);
+        bind(cmd, m_splat, false, true);
+        for (uint32_t l = 0; l < m_lightCount; ++l) {
+            const float cap = m_floatAtomics ? 0.0f : m_irradianceCaps[l];
+            vkCmdFillBuffer(cmd, m_count.handle(), 0, VK_WHOLE_SIZE, 0);
+            vk::memoryBarrier(cmd);
+            const VkDeviceSize args = VkDeviceSize(l) * kLightWords * 4;
+            push(cmd, {l, photons.count, kSplatCount, 0}, cap);
+            vkCmdDispatchIndirect(cmd, m_lights.handle(), args);
+            vk::memoryBarrier(cmd);
+            push(cmd, {l, photons.count, kSplatIrradiance, 0}, cap);
+            vkCmdDispatchIndirect(cmd, m_lights.handle(), args);
+            vk::memoryBarrier(cmd);
+        }
     }
     {
         PassScope pass(ctx, cmd, "svo_transfer");
@@ -418,12 +493,15 @@ void SparseVoxelOctree::addLayoutBindings(std::vector<VkDescriptorSetLayoutBindi
     out.push_back({first, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, stages, nullptr});
     out.push_back({first + 1, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, stages, nullptr});
     out.push_back({first + 2, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, nullptr});
+    out.push_back({first + 3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, stages, nullptr});
 }
 
 void SparseVoxelOctree::writeDescriptors(vk::DescriptorSet& set, uint32_t first) const {
     set.writeUniformBuffer(first, m_infoBuffer);
     set.writeBuffer(first + 1, m_nodes);
     set.writeSampledImage(first + 2, m_radiance.view(), m_sampler.handle(),
+                          VK_IMAGE_LAYOUT_GENERAL);
+    set.writeSampledImage(first + 3, m_normals.view(), m_sampler.handle(),
                           VK_IMAGE_LAYOUT_GENERAL);
 }
 
@@ -438,9 +516,10 @@ SparseVoxelOctree::Memory SparseVoxelOctree::memory() const {
     };
     m.geometryBytes = bytes(m_geometry);
     m.radianceBytes = bytes(m_radiance);
-    m.brickBytes = m.geometryBytes + m.radianceBytes;
-    m.scratchBytes =
-        size_t(m_accum.size() + m_occupancy.size() + m_counters.size() + m_infoBuffer.size());
+    m.normalBytes = bytes(m_normals) / 2;  // 4 bytes per texel
+    m.brickBytes = m.geometryBytes + m.radianceBytes + m.normalBytes;
+    m.scratchBytes = size_t(m_accum.size() + m_count.size() + m_lights.size() +
+                            m_occupancy.size() + m_counters.size() + m_infoBuffer.size());
     return m;
 }
 
@@ -455,7 +534,8 @@ SparseVoxelOctree::Memory SparseVoxelOctree::usedMemory() const {
     m.nodeBytes = size_t(c[0]) * kNodeBytes;
     m.geometryBytes = size_t(c[1]) * kBrickBytes;
     m.radianceBytes = size_t(c[3]) * kBrickBytes;
-    m.brickBytes = m.geometryBytes + m.radianceBytes;
+    m.normalBytes = size_t(c[1]) * kNormalBrickBytes;
+    m.brickBytes = m.geometryBytes + m.radianceBytes + m.normalBytes;
     return m;
 }
 
@@ -479,6 +559,16 @@ std::vector<glm::vec4> SparseVoxelOctree::readRadianceBricks() const {
 
 std::vector<glm::vec4> SparseVoxelOctree::readGeometryBricks() const {
     return toVec4(const_cast<vk::Image&>(m_geometry).readbackFloat(*m_vk));
+}
+
+std::vector<glm::vec4> SparseVoxelOctree::readNormalBricks() const {
+    const std::vector<uint8_t> raw = const_cast<vk::Image&>(m_normals).readback(*m_vk);
+    std::vector<glm::vec4> v(raw.size() / 4);
+    auto snorm = [](uint8_t b) { return std::max(float(int8_t(b)) / 127.0f, -1.0f); };
+    for (size_t i = 0; i < v.size(); ++i)
+        v[i] = glm::vec4(snorm(raw[4 * i]), snorm(raw[4 * i + 1]), snorm(raw[4 * i + 2]),
+                         snorm(raw[4 * i + 3]));
+    return v;
 }
 
 glm::uvec3 SparseVoxelOctree::brickTexel(uint32_t brick, glm::uvec3 s) const {

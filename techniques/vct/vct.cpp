@@ -109,6 +109,9 @@ TechniqueInfo VctTechnique::describe() {
                    "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane so the "
                    "surface's own cell is never gathered (0 = off; the octree adds 0.5 for its "
                    "vertex-centred samples; docs/voxel_cone_tracing.md)"),
+        enumParam("lift_rule", "cell", {"cell", "blend"},
+                  "cell: clear the coarser blended level's cell 2^ceil(L) (exact, no self-gather); "
+                  "blend: the two cell sizes mixed by the level weight (continuous in t)"),
         floatParam("opacity_cutoff", 0.99, 0.5, 1.0, "",
                    "a cone stops when its accumulated opacity reaches this"),
         boolParam("specular", true,
@@ -299,8 +302,8 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
     // The octree's vertex-centred samples carry a surface's data up to one cell away (not half
     // a cell as cell-centred voxels do): the same clearance needs half a cell more lift.
     const float lift = p.getFloat("lift");
-    g.misc = glm::vec4(p.getFloat("lod_offset"), lift > 0.0f && m_octree ? lift + 0.5f : lift, 0.0f,
-                       0.0f);
+    g.misc = glm::vec4(p.getFloat("lod_offset"), lift > 0.0f && m_octree ? lift + 0.5f : lift,
+                       p.getEnum("lift_rule") == "blend" ? 1.0f : 0.0f, 0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
     g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
