@@ -1,11 +1,11 @@
 // Brick-border transfer (Crassin §8.2 Fig. 9, notes 001 §2.6): per axis, pass A (pc.args.z = 0)
 // adds each node's + face (9 samples) into the - face of its + neighbour; pass B (1) copies the
 // sums back into the node's + face. One thread per node of depth pc.args.x, no atomics. Target
-// pc.args.w (SVO_TARGET_*): 0 the irradiance accumulators (3 words per sample, by brick), 1 radiance
-// (the slot's brick), 2 geometry bricks, 3 the six directional radiance bricks (slot + 0..5, each
-// transferred like an isotropic one; with the slab filter only along the two axes across the
-// face's axis, see svo_filter_aniso.comp). Separable, so edges (4 copies) and corners (8) are
-// complete after x, y, z.
+// pc.args.w (SVO_TARGET_*): 0 the irradiance accumulators (3 words per sample, by brick), 1
+// radiance (the slot's brick), 2 geometry bricks, 3 the six directional radiance bricks (slot +
+// 0..5, each transferred like an isotropic one; with the slab filter only along the two axes
+// across the face's axis, see svo_filter_aniso.comp). Separable, so edges (4 copies) and corners
+// (8) are complete after x, y, z.
 #include "vct/svo_common.glsl"
 
 layout(local_size_x = SVO_GROUP_SIZE) in;

@@ -271,10 +271,11 @@ void SparseVoxelOctree::createPipelines() {
                                            {8, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs},
                                            {9, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, kCs}},
                                           "vct/svo");
-    m_voxelLayout = vk::DescriptorSetLayout(vk,
-                                            {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs},
-                                             {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs}},
-                                            "vct/svo_voxels");
+    m_voxelLayout =
+        vk::DescriptorSetLayout(vk,
+                                {{0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs},
+                                 {1, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, kCs}},
+                                "vct/svo_voxels");
     m_photonLayout = vk::DescriptorSetLayout(vk, {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, kCs}},
                                              "vct/svo_photons");
     m_set = vk::DescriptorSet(vk, m_setLayout, 0, "vct/svo");
@@ -501,8 +502,7 @@ void SparseVoxelOctree::writeDescriptors(vk::DescriptorSet& set, uint32_t first)
     set.writeBuffer(first + 1, m_nodes);
     set.writeSampledImage(first + 2, m_radiance.view(), m_sampler.handle(),
                           VK_IMAGE_LAYOUT_GENERAL);
-    set.writeSampledImage(first + 3, m_normals.view(), m_sampler.handle(),
-                          VK_IMAGE_LAYOUT_GENERAL);
+    set.writeSampledImage(first + 3, m_normals.view(), m_sampler.handle(), VK_IMAGE_LAYOUT_GENERAL);
 }
 
 SparseVoxelOctree::Memory SparseVoxelOctree::memory() const {
@@ -518,8 +518,8 @@ SparseVoxelOctree::Memory SparseVoxelOctree::memory() const {
     m.radianceBytes = bytes(m_radiance);
     m.normalBytes = bytes(m_normals) / 2;  // 4 bytes per texel
     m.brickBytes = m.geometryBytes + m.radianceBytes + m.normalBytes;
-    m.scratchBytes = size_t(m_accum.size() + m_count.size() + m_lights.size() +
-                            m_occupancy.size() + m_counters.size() + m_infoBuffer.size());
+    m.scratchBytes = size_t(m_accum.size() + m_count.size() + m_lights.size() + m_occupancy.size() +
+                            m_counters.size() + m_infoBuffer.size());
     return m;
 }
 
