@@ -274,9 +274,12 @@ constexpr double kAgreementMeanRatio = 0.2;  // measured 1.066
 // Both anisotropic. Issue 9 asks for the mean within 15 %; measured 0.725: facing removed the
 // octree's excess on the floor (1.51x -> 0.76x the reference; dense 0.91x), the octree's ceiling
 // stays at 0.61x (dense 1.02x), see docs/vct_svo.md.
-constexpr double kAnisoAgreementRelMse = 0.25;    // measured 0.171
-constexpr double kAnisoAgreementMeanAbs = 0.6;    // measured 0.324
-constexpr double kAnisoAgreementMeanRatio = 0.3;  // measured 0.725
+// Default octree_filter = slab (walls on odd samples stay opaque; the dense pyramid has no parity
+// problem but is dimmer than the reference at 64^3-128^3): measured relMSE 0.108, mean |diff|
+// 0.318, octree / dense 1.235 (pairs: 0.171, 0.324, 0.725).
+constexpr double kAnisoAgreementRelMse = 0.25;
+constexpr double kAnisoAgreementMeanAbs = 0.6;
+constexpr double kAnisoAgreementMeanRatio = 0.3;
 
 TEST_F(GpuVctSvoTest, LeafNodesAreTheOccupiedLeafCells) {
     build(boxScene(kAlbedo, kLo, kHi));

@@ -82,6 +82,11 @@ TechniqueInfo VctTechnique::describe() {
                   "radiance storage: dense 3D textures with mips, or the paper's sparse voxel "
                   "octree with 3^3 bricks",
                   rebuild),
+        enumParam("octree_filter", "slab", {"pairs", "slab"},
+                  "octree directional bricks: pairs = the dense rule (front-to-back child pairs "
+                  "in the Gaussian, Crassin §9); slab = front to back through the parent's whole "
+                  "footprint (walls on odd samples stay opaque; docs/vct_svo.md)",
+                  rebuild),
         boolParam("anisotropic", true,
                   "6 directional mip volumes (dense) or directional bricks above the leaves "
                   "(octree) (Crassin §9); off = isotropic mips with the 3^3 Gaussian filter",
@@ -196,7 +201,10 @@ void VctTechnique::setup(TechniqueContext& ctx) {
         });
     } else {
         const bool anisotropic = p.getBool("anisotropic");
-        m_svo = std::make_unique<vct::SparseVoxelOctree>(ctx, m_grid, anisotropic);
+        const auto filter = p.getEnum("octree_filter") == "slab"
+                                ? vct::SparseVoxelOctree::DirectionalFilter::Slab
+                                : vct::SparseVoxelOctree::DirectionalFilter::Pairs;
+        m_svo = std::make_unique<vct::SparseVoxelOctree>(ctx, m_grid, anisotropic, filter);
         ctx.submitTimed([&](VkCommandBuffer cmd) {
             m_voxelizer->record(cmd, ctx.timer);
             {
