@@ -17,11 +17,10 @@
 // cells reach every voxel the plane crosses, even where it only clips a corner. Photons whose
 // surface faces away from the light (normal.w = 0) and misses deposit nothing.
 #include "vct/inject_common.glsl"
+#include "vct/photon_footprint.glsl"
 
 layout(local_size_x = 64) in;
 
-const int kMaxCellsPerEdge = 16;
-const int kMaxCells = 64;
 
 bool covered(ivec3 c) {
     return voxelInside(pc.grid, c) && texelFetch(voxelAlbedoOpacity, c, 0).a > 0.0;
@@ -133,29 +132,13 @@ void main() {
     }
     ex *= 2.0 / float(res.x);
     ey *= 2.0 / float(res.y);
-    // Cells of at most v0 / 2 per side; very long footprints (grazing) are clipped
-    float cell = 0.5 * v0;
-    float maxEdge = float(kMaxCellsPerEdge) * cell;
-    float lx = length(ex), ly = length(ey);
-    if (lx > maxEdge) ex *= maxEdge / lx;
-    if (ly > maxEdge) ey *= maxEdge / ly;
-    int kx = clamp(int(ceil(min(lx, maxEdge) / cell)), 1, kMaxCellsPerEdge);
-    int ky = clamp(int(ceil(min(ly, maxEdge) / cell)), 1, kMaxCellsPerEdge);
-    while (kx * ky > kMaxCells) {
-        if (kx >= ky) kx = (kx + 1) / 2; else ky = (ky + 1) / 2;
-    }
-    vec3 cx = ex / float(kx), cy = ey / float(ky);
-    float r = clamp(0.5 * max(length(cx + cy), length(cx - cy)), 0.1 * v0, 0.5 * v0);
+    FootprintCells cells = footprintCells(ex, ey, v0);
 
     vec3 e = max(p.irradiance.rgb, vec3(0.0));
 #ifdef INJECT_FIXED_POINT
     e = min(e, vec3(pc.params.x));
 #endif
-    for (int b = 0; b < ky; ++b) {
-        for (int a = 0; a < kx; ++a) {
-            vec3 q = x + ((float(a) + 0.5) / float(kx) - 0.5) * ex +
-                     ((float(b) + 0.5) / float(ky) - 0.5) * ey;
-            deposit(q, n, r, e);
-        }
-    }
+    for (int b = 0; b < cells.ky; ++b)
+        for (int a = 0; a < cells.kx; ++a)
+            deposit(x + footprintCellOffset(cells, a, b), n, cells.radius, e);
 }

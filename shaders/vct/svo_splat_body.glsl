@@ -23,6 +23,7 @@
 // so the count read by the irradiance pass is complete without a transfer; afterwards the other
 // copies hold 0 and svo_transfer's add / copy passes give every copy the canonical sum.
 #include "vct/svo_common.glsl"
+#include "vct/photon_footprint.glsl"
 
 layout(set = 2, binding = 0, std430) readonly buffer Photons {
     Photon photons[];
@@ -32,8 +33,6 @@ layout(local_size_x = SVO_GROUP_SIZE) in;
 #define SVO_SPLAT_COUNT 0u
 #define SVO_SPLAT_IRRADIANCE 1u
 
-const int kMaxCellsPerEdge = 16;
-const int kMaxCells = 64;
 
 // One-entry cache of the last leaf looked up (a photon's deposits fall in a few leaves).
 uvec3 gCell = uvec3(0xFFFFFFFFu);
@@ -128,26 +127,11 @@ void main() {
     vec3 ex = t * (w / cosTheta);
     vec3 ey = cross(n, t) * w;
 
-    // Cells of at most v0 / 2 per side; very long footprints (grazing) are clipped
-    float cell = 0.5 * v0;
-    float maxEdge = float(kMaxCellsPerEdge) * cell;
-    float lx = length(ex), ly = length(ey);
-    if (lx > maxEdge) ex *= maxEdge / lx;
-    if (ly > maxEdge) ey *= maxEdge / ly;
-    int kx = clamp(int(ceil(min(lx, maxEdge) / cell)), 1, kMaxCellsPerEdge);
-    int ky = clamp(int(ceil(min(ly, maxEdge) / cell)), 1, kMaxCellsPerEdge);
-    while (kx * ky > kMaxCells) {
-        if (kx >= ky) kx = (kx + 1) / 2; else ky = (ky + 1) / 2;
-    }
-    vec3 cx = ex / float(kx), cy = ey / float(ky);
-    float r = clamp(0.5 * max(length(cx + cy), length(cx - cy)), 0.1 * v0, 0.5 * v0);
+    FootprintCells cells = footprintCells(ex, ey, v0);
 
     vec3 g0 = (p.positionValid.xyz - svo.originVoxelSize.xyz) / v0;
-    for (int b = 0; b < ky; ++b) {
-        for (int a = 0; a < kx; ++a) {
-            vec3 q = ((float(a) + 0.5) / float(kx) - 0.5) * ex +
-                     ((float(b) + 0.5) / float(ky) - 0.5) * ey;
-            deposit(g0 + q / v0, n, r / v0, e, countMode);
-        }
-    }
+    for (int b = 0; b < cells.ky; ++b)
+        for (int a = 0; a < cells.kx; ++a)
+            deposit(g0 + footprintCellOffset(cells, a, b) / v0, n, cells.radius / v0, e,
+                    countMode);
 }
