@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/vct_test_rig.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/image/image.h"
@@ -34,51 +35,9 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 const glm::vec3 kAlbedo(0.6f, 0.5f, 0.4f);
 
-Scene cornell(const std::string& variant, int size = 64) {
-    Scene scene =
-        loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", variant);
-    scene.settings.width = size;
-    scene.settings.height = size;
-    return scene;
-}
-
-ParamSet vctParams(std::initializer_list<std::pair<const char*, const char*>> values) {
-    ParamSet p = TechniqueRegistry::instance().defaultParams("vct");
-    p.set("voxel_resolution", "32");
-    for (const auto& [k, v] : values)
-        p.set(k, v);
-    return p;
-}
-
-/** A VctTechnique set up outside the harness, so tests can reach its injection. */
-struct Rig {
-    Rig(vk::Context& vk, Scene s, ParamSet p)
-        : scene(std::move(s)),
-          params(std::move(p)),
-          gpuScene(vk, scene),
-          shared(vk, gpuScene, uint32_t(scene.settings.width), uint32_t(scene.settings.height)),
-          ctx{vk,
-              scene,
-              gpuScene,
-              shared,
-              params,
-              uint32_t(scene.settings.width),
-              uint32_t(scene.settings.height),
-              nullptr,
-              &skipped,
-              &notes,
-              "vct",
-              nullptr} {
-        technique.setup(ctx);
-    }
-    Scene scene;
-    ParamSet params;
-    vk::GpuScene gpuScene;
-    SharedPasses shared;
-    std::vector<std::string> skipped, notes;
-    TechniqueContext ctx;
-    VctTechnique technique;
-};
+using test::cornell;
+using test::vctParams;
+using test::VctRig;
 
 /** The plane of the test: a square of side `size` centred at the origin, its normal tilted by
  *  `tiltDeg` from +y about the z axis (0: horizontal; 45: at 45 degrees to two voxel axes). */
@@ -130,7 +89,7 @@ struct Agreement {
  * projects onto the plane's interior (2 voxels from its edges) with E(x) = intensity x
  * geometry(x) at that projection: radiance = a albedo / pi E with a = 1.
  */
-Agreement compare(Rig& rig, const Plane& plane, const glm::vec3& intensity,
+Agreement compare(VctRig& rig, const Plane& plane, const glm::vec3& intensity,
                   const std::function<double(glm::vec3)>& geometry) {
     const VoxelGrid& grid = rig.technique.grid();
     const float v0 = grid.voxelSize();
@@ -187,7 +146,7 @@ TEST_F(GpuVctInjection, PlaneUnderDirectionalLightIsExactAtAnyTilt) {
         light.type = LightType::Directional;
         light.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.3f));
         light.intensity = glm::vec3(2.0f, 1.0f, 0.5f);
-        Rig rig(*m_ctx, planeScene(plane, light), vctParams({}));
+        VctRig rig(*m_ctx, planeScene(plane, light), vctParams({}));
         const double cosTheta = -glm::dot(plane.n, light.direction);
         const Agreement a =
             compare(rig, plane, light.intensity, [&](glm::vec3) { return cosTheta; });
@@ -211,7 +170,7 @@ TEST_F(GpuVctInjection, PlaneUnderPointLightMatchesInverseSquare) {
         light.type = LightType::Point;
         light.position = 1.5f * plane.n;
         light.intensity = glm::vec3(3.0f, 2.0f, 1.0f);
-        Rig rig(*m_ctx, planeScene(plane, light), vctParams({}));
+        VctRig rig(*m_ctx, planeScene(plane, light), vctParams({}));
         const Agreement a = compare(rig, plane, light.intensity, [&](glm::vec3 p) {
             const glm::dvec3 d = glm::dvec3(light.position) - glm::dvec3(p);
             const double r = glm::length(d);
@@ -329,7 +288,7 @@ TEST(CpuVctInjection, AutoMapSizesFollowTheFootprintRuleAndTheBudget) {
 // The area-lit Cornell box (the built-in default): the photons of the emitter samples' hemicubes
 // carry the emitters' whole flux, pi Le A (Lambertian, one-sided), to within the quadrature error.
 TEST_F(GpuVctInjection, EmitterPhotonsCarryTheAreaLightsFlux) {
-    Rig rig(*m_ctx, cornell(""), vctParams({{"light_map_resolution", "64"}}));
+    VctRig rig(*m_ctx, cornell(""), vctParams({{"light_map_resolution", "64"}}));
     const auto& inj = *rig.technique.injection();
     ASSERT_EQ(inj.batchCount(), 1u);
     const uint32_t samples = uint32_t(rig.shared.shadows().emitterSamples().size());

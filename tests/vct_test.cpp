@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/vct_test_rig.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/image/image.h"
@@ -25,51 +26,9 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-Scene cornell(const std::string& variant) {
-    Scene scene =
-        loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", variant);
-    scene.settings.width = 64;
-    scene.settings.height = 64;
-    return scene;
-}
-
-ParamSet vctParams(std::initializer_list<std::pair<const char*, const char*>> values) {
-    ParamSet p = TechniqueRegistry::instance().defaultParams("vct");
-    p.set("voxel_resolution", "32");
-    for (const auto& [k, v] : values)
-        p.set(k, v);
-    return p;
-}
-
-/** A VctTechnique set up outside the harness, so tests can reach its injection. */
-struct VctRig {
-    VctRig(vk::Context& vk, Scene s, ParamSet p)
-        : scene(std::move(s)),
-          params(std::move(p)),
-          gpuScene(vk, scene),
-          shared(vk, gpuScene, uint32_t(scene.settings.width), uint32_t(scene.settings.height)),
-          ctx{vk,
-              scene,
-              gpuScene,
-              shared,
-              params,
-              uint32_t(scene.settings.width),
-              uint32_t(scene.settings.height),
-              nullptr,
-              &skipped,
-              &notes,
-              "vct",
-              nullptr} {
-        technique.setup(ctx);
-    }
-    Scene scene;
-    ParamSet params;
-    vk::GpuScene gpuScene;
-    SharedPasses shared;
-    std::vector<std::string> skipped, notes;
-    TechniqueContext ctx;
-    VctTechnique technique;
-};
+using test::cornell;
+using test::vctParams;
+using test::VctRig;
 
 glm::dvec3 totalFlux(const std::vector<vct::GpuPhoton>& photons, bool validOnly) {
     glm::dvec3 sum(0.0);

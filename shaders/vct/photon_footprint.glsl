@@ -38,4 +38,13 @@ vec3 footprintCellOffset(FootprintCells f, int a, int b) {
            ((float(b) + 0.5) / float(f.ky) - 0.5) * f.ey;
 }
 
+// Whether the tangent plane (normal n) through grid point g crosses voxel c within rg (grid
+// units) of g: the deposit rule of both splats.
+bool footprintTouchesVoxel(ivec3 c, vec3 g, vec3 n, float rg) {
+    float halfExtent = 0.5 * (abs(n.x) + abs(n.y) + abs(n.z)) + 1e-4;
+    if (abs(dot(n, vec3(c) + 0.5 - g)) > halfExtent) return false;
+    vec3 d = max(max(vec3(c) - g, g - vec3(c + 1)), vec3(0.0));
+    return dot(d, d) <= rg * rg;
+}
+
 #endif  // GILAB_VCT_PHOTON_FOOTPRINT_GLSL

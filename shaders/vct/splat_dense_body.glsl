@@ -70,15 +70,11 @@ void deposit(vec3 q, vec3 n, float r, vec3 e) {
     float rg = r / voxelSize(pc.grid);
     ivec3 lo = ivec3(floor(g - rg));
     ivec3 hi = ivec3(floor(g + rg));
-    float halfExtent = 0.5 * (abs(n.x) + abs(n.y) + abs(n.z)) + 1e-4;
     for (int z = lo.z; z <= hi.z; ++z) {
         for (int y = lo.y; y <= hi.y; ++y) {
             for (int x = lo.x; x <= hi.x; ++x) {
                 ivec3 c = ivec3(x, y, z);
-                if (!covered(c)) continue;
-                if (abs(dot(n, vec3(c) + 0.5 - g)) > halfExtent) continue;
-                vec3 d = max(max(vec3(c) - g, g - vec3(c + 1)), vec3(0.0));
-                if (dot(d, d) > rg * rg) continue;
+                if (!covered(c) || !footprintTouchesVoxel(c, g, n, rg)) continue;
                 uint index = voxelLinearIndex(pc.grid, c);
                 if (pc.counts.z == INJECT_MODE_COUNT) {
                     atomicAdd(photonCount[index], 1u);

@@ -69,14 +69,11 @@ void addIrradiance(uint base, vec3 e) {
 void deposit(vec3 g, vec3 n, float rg, vec3 e, bool countMode) {
     ivec3 lo = ivec3(floor(g - rg));
     ivec3 hi = ivec3(floor(g + rg));
-    float halfExtent = 0.5 * (abs(n.x) + abs(n.y) + abs(n.z)) + 1e-4;
     for (int z = lo.z; z <= hi.z; ++z) {
         for (int y = lo.y; y <= hi.y; ++y) {
             for (int x = lo.x; x <= hi.x; ++x) {
                 ivec3 c = ivec3(x, y, z);
-                if (abs(dot(n, vec3(c) + 0.5 - g)) > halfExtent) continue;
-                vec3 d = max(max(vec3(c) - g, g - vec3(c + 1)), vec3(0.0));
-                if (dot(d, d) > rg * rg) continue;
+                if (!footprintTouchesVoxel(c, g, n, rg)) continue;
                 int index = coveredSample(c);
                 if (index < 0) continue;
                 if (countMode) {
