@@ -92,12 +92,14 @@ TEST_F(GpuSelfGather, LitFloorGathersNoLightFromItself) {
 }
 
 TEST_F(GpuSelfGather, OctreeWithTheDenseLiftGathersALittle) {
-    // The octree's extra half cell of lift (docs/vct_svo.md "Lift"): with the dense lift (its
-    // `lift` 1.0 + 0.5 = 1.5) the floor's own cells reach the lifted samples' footprint.
+    // The octree's extra lift (docs/vct_svo.md "Lift"): with the dense clearance (octree_lift_extra
+    // 0) the floor's own cells reach the lifted samples' footprint.
     const FloorGather g = floorGather(
-        *m_ctx, "vct", {{"voxel_resolution", "64"}, {"storage", "octree"}, {"lift", "1.0"}});
-    std::printf("vct octree 64^3 lift 1.0: floor indirect / (albedo x radiance) = %.4f\n",
-                g.ratio());
+        *m_ctx, "vct",
+        {{"voxel_resolution", "64"}, {"storage", "octree"}, {"octree_lift_extra", "0"}});
+    std::printf(
+        "vct octree 64^3 octree_lift_extra 0: floor indirect / (albedo x radiance) = %.4f\n",
+        g.ratio());
     EXPECT_GT(g.ratio(), 0.005);
     EXPECT_LT(g.ratio(), 0.05);
 }
