@@ -1,5 +1,7 @@
 #include "experiments/cli/cli.h"
 
+#include "experiments/cli/compare_command.h"
+
 #include <unistd.h>
 
 #include <charconv>
@@ -193,6 +195,27 @@ int runMain(int argc, char** argv) {
         ->required();
     reportCmd->add_option("--out,-o", reportOut, "Output folder (default: the first folder)");
 
+    CompareOptions compare;
+    CLI::App* compareCmd = app.add_subcommand(
+        "compare", "Every metric between two images (the second is the reference); error maps");
+    compareCmd->add_option("test", compare.test, "Test image: file.exr[:layer] (EXR, PNG, HDR)")
+        ->required();
+    compareCmd->add_option("reference", compare.reference, "Reference image: file.exr[:layer]")
+        ->required();
+    compareCmd->add_option("--metrics", compare.metrics,
+                           "Comma-separated: flip,hdr-flip,relmse,psnr,ssim (default: all)")
+        ->delimiter(',');
+    compareCmd->add_option("--mask", compare.mask,
+                           "Mask image: pool every metric over pixels whose channel 0 > 0.5");
+    compareCmd->add_option("--out,-o", compare.outDir,
+                           "Also write the error maps (PNG and EXR) and compare.json here");
+    compareCmd->add_option("--flip-exposure", compare.flipExposure,
+                           "HDR-FLIP exposure range start:stop (stops), e.g. -4:2; default: "
+                           "computed from the reference");
+    compareCmd->add_option("--ppd", compare.ppd, "FLIP pixels per degree (default 67)")
+        ->check(CLI::Range(1.0, 1000.0));
+    compareCmd->add_flag("--json", compare.json, "Print the JSON summary instead of the table");
+
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
@@ -212,6 +235,7 @@ int runMain(int argc, char** argv) {
             return runExperimentCommand(run);
         }
         if (*reportCmd) return runReport(reportDirs, reportOut);
+        if (*compareCmd) return runCompare(compare);
     } catch (const Error& e) {
         std::fprintf(stderr, "gilab: error: %s\n", e.what());
         return kExitError;
