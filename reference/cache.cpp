@@ -188,8 +188,11 @@ Accumulator readAccumulatorFile(const fs::path& path) {
 ReferenceCache::ReferenceCache(fs::path dir) : m_dir(std::move(dir)) {}
 
 fs::path ReferenceCache::defaultDir() {
-    const char* env = std::getenv("GILAB_REFERENCE_CACHE");
-    return (env && *env) ? fs::path(env) : fs::path("results/cache/reference");
+    // The one place that decides where references are cached (docs/reference_cache.md).
+    if (const char* root = std::getenv("GILAB_CACHE"); root && *root)
+        return fs::path(root) / "reference";
+    if (const char* env = std::getenv("GILAB_REFERENCE_CACHE"); env && *env) return env;
+    return fs::path("results/cache/reference");
 }
 
 fs::path ReferenceCache::entryDir(const std::string& key) const {
@@ -232,6 +235,13 @@ std::optional<CachedReference> ReferenceCache::load(const std::string& key) cons
 void ReferenceCache::store(const std::string& key, const Accumulator& acc,
                            const nlohmann::ordered_json& sidecar) const {
     const fs::path finalDir = entryDir(key);
+    if (!fs::exists(m_dir)) {
+        // Say so: a command run from another folder would otherwise scatter caches silently.
+        std::fprintf(stderr,
+                     "gilab: creating the reference cache %s (set GILAB_CACHE or pass "
+                     "--cache / --reference-cache to use one cache everywhere)\n",
+                     fs::absolute(m_dir).lexically_normal().string().c_str());
+    }
     fs::create_directories(m_dir);
     removeStaleTemporaries(std::chrono::hours(24));
 

@@ -45,7 +45,8 @@ class ReferenceCache {
 public:
     explicit ReferenceCache(std::filesystem::path dir);
 
-    /** $GILAB_REFERENCE_CACHE when set and not empty, else "results/cache/reference". */
+    /** $GILAB_CACHE/reference, else $GILAB_REFERENCE_CACHE (older name), else
+     *  "results/cache/reference" relative to the working folder (announced when created). */
     static std::filesystem::path defaultDir();
 
     const std::filesystem::path& dir() const { return m_dir; }

@@ -140,28 +140,46 @@ TEST(CpuExperimentConfig, ShardsParse) {
 TEST(CpuRunStore, RowsAreAppendedAndFlattened) {
     const fs::path dir = tempDir("store");
     RunStore store(dir);
-    nlohmann::ordered_json result = {{"key", "k1"},
-                                     {"index", 0},
-                                     {"status", "ok"},
-                                     {"technique", {{"id", "direct"}, {"params", {{"a", 1}}}}},
-                                     {"metrics", {{"final", {{"flip", {{"mean", 0.25}}}}}}}};
+    nlohmann::ordered_json result = {
+        {"key", "k1"},
+        {"index", 0},
+        {"status", "ok"},
+        {"technique", {{"id", "direct"}, {"params", {{"a", 1}}}, {"swept", {{"a", 1}}}}},
+        {"shared_params", {{"area_light_samples", 16}}},
+        {"metrics",
+         {{"final", {{"flip", {{"mean", 0.25}}}}},
+          {"final_vs_full", {{"flip", {{"mean", 0.5}}}, {"rel_mse", 0.1}}},
+          {"regions", {{"ceiling", {{"energy_ratio", 0.9}}}}}}}};
     store.appendRow(resultRow(result));
+    // A second technique with other parameters: results.csv keeps the union of the columns.
+    result["key"] = "k2";
+    result["technique"] = {{"id", "vct"}, {"params", {{"b", "x"}}}};
     store.appendRow(resultRow(result));
     std::ifstream jsonl(dir / "results.jsonl");
     std::string line;
-    int rows = 0;
-    while (std::getline(jsonl, line)) {
-        const auto row = nlohmann::json::parse(line);
-        EXPECT_EQ(row["flip_mean"], 0.25);
-        EXPECT_EQ(row["params"], "a=1");
-        ++rows;
-    }
-    EXPECT_EQ(rows, 2);
+    std::vector<nlohmann::json> rows;
+    while (std::getline(jsonl, line))
+        rows.push_back(nlohmann::json::parse(line));
+    ASSERT_EQ(rows.size(), 2u);
+    EXPECT_EQ(rows[0]["matched.flip"], 0.25);
+    EXPECT_EQ(rows[0]["full.flip"], 0.5);
+    EXPECT_EQ(rows[0]["full.rel_mse"], 0.1);
+    EXPECT_EQ(rows[0]["param.a"], 1);
+    EXPECT_EQ(rows[0]["shared.area_light_samples"], 16);
+    EXPECT_EQ(rows[0]["swept"], "a");
+    EXPECT_EQ(rows[0]["params"], "a=1");
+    EXPECT_EQ(rows[0]["region.ceiling.energy_ratio"], 0.9);
+    EXPECT_EQ(rows[1]["param.b"], "x");
+    EXPECT_FALSE(rows[1].contains("param.a"));
+
     std::ifstream csv(dir / "results.csv");
-    int csvLines = 0;
+    std::vector<std::string> lines;
     while (std::getline(csv, line))
-        ++csvLines;
-    EXPECT_EQ(csvLines, 3);  // header + 2 rows
+        lines.push_back(line);
+    ASSERT_EQ(lines.size(), 3u);  // header + 2 rows
+    EXPECT_NE(lines[0].find("param.a"), std::string::npos) << lines[0];
+    EXPECT_NE(lines[0].find("param.b"), std::string::npos) << lines[0];
+    EXPECT_NE(lines[0].find("shared.area_light_samples"), std::string::npos) << lines[0];
     fs::remove_all(dir);
 }
 

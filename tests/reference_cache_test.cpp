@@ -428,8 +428,12 @@ TEST(CpuReferenceCommand, WritesOutputsAndReusesTheCache) {
     EXPECT_TRUE(j["rel_error"].is_number());
     EXPECT_EQ(j["nonfinite_samples"], 0);
     const auto layers = readExrLayers((out / "reference.exr").string());
-    ASSERT_EQ(layers.size(), size_t(2 * ref::kLayerCount));
+    // The plain R,G,B channels (the main image, `full`) + mean and stderr layers.
+    ASSERT_EQ(layers.size(), size_t(2 * ref::kLayerCount + 1));
+    EXPECT_EQ(layers[0].name, "");
     EXPECT_EQ(layers[0].image.width(), 12);
+    ASSERT_NE(findLayer(layers, "full"), nullptr);
+    EXPECT_EQ(layers[0].image.values(), findLayer(layers, "full")->values());
 
     ASSERT_EQ(cli::runReference(o), cli::kExitOk);
     j = readJson(out / "reference.json");

@@ -217,14 +217,23 @@ TEST_F(GpuHarness, RenderCommandWritesExrPngAndSidecar) {
     o.assignments = {"shared.area_light_samples=4"};
     ASSERT_EQ(cli::runRender(o), cli::kExitOk);
 
-    const auto layers = readExrLayers((out / "direct.exr").string());
-    ASSERT_EQ(layers.size(), 7u);
-    EXPECT_EQ(layers[0].name, "final");
-    EXPECT_EQ(layers[0].image.width(), 32);
-    EXPECT_EQ(layers[0].image.height(), 24);
-    EXPECT_TRUE(std::filesystem::exists(out / "direct.png"));
+    // Same file names as a `gilab run` folder; the main image is also the plain R,G,B.
+    const auto layers = readExrLayers((out / "output.exr").string());
+    ASSERT_EQ(layers.size(), 8u);
+    EXPECT_EQ(layers[0].name, "");
+    EXPECT_EQ(layers[1].name, "final");
+    EXPECT_EQ(layers[0].image.values(), layers[1].image.values());
+    EXPECT_EQ(layers[1].image.width(), 32);
+    EXPECT_EQ(layers[1].image.height(), 24);
+    EXPECT_TRUE(std::filesystem::exists(out / "final.png"));
+    EXPECT_TRUE(std::filesystem::exists(out / "indirect.png"));
 
-    std::ifstream in(out / "direct.json");
+    // An existing output is not overwritten without --force.
+    EXPECT_THROW(cli::runRender(o), Error);
+    o.force = true;
+    ASSERT_EQ(cli::runRender(o), cli::kExitOk);
+
+    std::ifstream in(out / "result.json");
     const nlohmann::json meta = nlohmann::json::parse(in);
     EXPECT_EQ(meta["status"], "ok");
     EXPECT_EQ(meta["shared_params"]["area_light_samples"], 4);

@@ -154,11 +154,11 @@ TEST(GpuInvalidRuns, RenderSavesInvalidStatusAndExitsWithCode5) {
     o.validation = true;
     EXPECT_EQ(cli::runRender(o), cli::kExitInvalid);
 
-    const nlohmann::json meta = readJson(out / "test_invalid_barrier.json");
+    const nlohmann::json meta = readJson(out / "result.json");
     EXPECT_EQ(meta["status"], "invalid");
     EXPECT_GE(meta["validation"]["errors"].get<uint32_t>(), 1u);
     EXPECT_FALSE(meta["validation"]["messages"].empty());
-    EXPECT_TRUE(fs::exists(out / "test_invalid_barrier.exr"));  // outputs kept for inspection
+    EXPECT_TRUE(fs::exists(out / "output.exr"));  // outputs kept for inspection
     fs::remove_all(out);
 }
 

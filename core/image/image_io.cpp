@@ -108,6 +108,17 @@ void writeImageAtomic(const std::string& path, const char* formatName, const OII
 
 }  // namespace detail
 
+void writeExrWithMainImage(const std::string& path, const std::vector<ImageLayer>& layers,
+                           const std::string& mainLayer) {
+    const Image* main = findLayer(layers, mainLayer);
+    if (!main) throw Error(path + ": no layer '" + mainLayer + "' to write as the main image");
+    std::vector<ImageLayer> withMain;
+    withMain.reserve(layers.size() + 1);
+    withMain.push_back({"", *main});
+    withMain.insert(withMain.end(), layers.begin(), layers.end());
+    writeExrLayers(path, withMain);
+}
+
 void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& layers) {
     validateLayers(path, layers);
     const int width = layers[0].image.width();

@@ -26,6 +26,13 @@ void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& laye
  * lists the channels. Within a layer: R, G, B, A, then others. Only the first part is read.
  */
 std::vector<ImageLayer> readExrLayers(const std::string& path);
+/**
+ * writeExrLayers with the layer `mainLayer` also written as the plain "R", "G", "B" channels,
+ * so viewers that open the default channels (oiiotool, Blender) show the main image
+ * (docs/conventions.md "Output files"). Throws if there is no such layer.
+ */
+void writeExrWithMainImage(const std::string& path, const std::vector<ImageLayer>& layers,
+                           const std::string& mainLayer);
 /** The layer named `name`, or nullptr. */
 const Image* findLayer(const std::vector<ImageLayer>& layers, const std::string& name);
 

@@ -1,4 +1,5 @@
 // Scene description files: reading, variants, and applying a description to its geometry.
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -130,6 +131,24 @@ Camera makeFramingCamera(const Bounds& bounds) {
     cam.nearZ = std::max(1e-3f, 1e-3f * distance);
     cam.farZ = std::max(1000.0f, 4.0f * (distance + radius));
     return cam;
+}
+
+Scene loadScene(const std::string& spec) {
+    if (spec.empty() || spec == "builtin") return makeBuiltinDefaultScene();
+    const size_t hash = spec.rfind('#');
+    const std::string file = spec.substr(0, hash);
+    std::string ext = fs::path(file).extension().string();
+    for (char& c : ext)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (ext == ".gltf" || ext == ".glb") {
+        if (hash != std::string::npos)
+            throw Error(file + ": a glTF file has no variants (\"#" + spec.substr(hash + 1) +
+                        "\"); variants belong to scene descriptions (.json, docs/scenes.md)");
+        return loadGltf(file);
+    }
+    if (ext == ".json") return loadSceneFile(spec);
+    throw Error(file + ": not a scene: expected a scene description (.json, optionally " +
+                "#variant), a glTF file (.gltf or .glb) or \"builtin\"");
 }
 
 Scene loadSceneFile(const std::string& pathWithVariant, const std::string& variantArg) {

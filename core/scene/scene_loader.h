@@ -25,6 +25,14 @@ Scene loadSceneFile(const std::string& path, const std::string& variant = "");
  */
 Scene loadGltf(const std::string& path);
 
+/**
+ * Any scene a command line or config names: "" or "builtin" (the built-in Cornell box), a
+ * scene description "file.json[#variant]", or a glTF file "file.gltf" / "file.glb" (camera from
+ * the file, else a framing camera and a warning). Anything else throws gilab::Error saying
+ * what was expected.
+ */
+Scene loadScene(const std::string& spec);
+
 /** The scene used when none is given: the procedural Cornell box with its ceiling area light. */
 Scene makeBuiltinDefaultScene();
 

@@ -224,15 +224,14 @@ void Context::pickDevice(const std::string& filter) {
         std::string message;
         if (!filter.empty()) {
             message = "no usable Vulkan device matches device filter '" + filter +
-                      "' (ContextOptions::deviceFilter or GILAB_DEVICE); candidates: " + list();
+                      "' (--device or GILAB_DEVICE); candidates: " + list();
         } else {
             message = "no usable Vulkan device: ";
             for (size_t i = 0; i < m_candidates.size(); ++i) {
                 message += (i ? "; " : "") + m_candidates[i].name + ": " + m_candidates[i].reason;
             }
         }
-        std::fprintf(stderr, "gilab: %s\n", message.c_str());
-        throw Error(message);
+        throw Error(message);  // printed once, by whoever catches it
     }
 
     for (size_t i = 0; i < m_candidates.size(); ++i) {

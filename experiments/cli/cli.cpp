@@ -4,6 +4,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -12,9 +13,102 @@
 #include <CLI/CLI.hpp>
 
 #include "core/util/atomic_file.h"
+#include "core/util/build_info.h"
 #include "core/util/error.h"
 
 namespace gilab::cli {
+
+namespace {
+
+constexpr const char* kSceneHelp =
+    "Scene: a description (.json, optionally #variant), a glTF file (.gltf/.glb) or builtin; "
+    "default: the built-in Cornell box (docs/scenes.md)";
+
+size_t editDistance(const std::string& a, const std::string& b) {
+    std::vector<size_t> row(b.size() + 1);
+    for (size_t j = 0; j <= b.size(); ++j)
+        row[j] = j;
+    for (size_t i = 1; i <= a.size(); ++i) {
+        size_t diagonal = row[0];
+        row[0] = i;
+        for (size_t j = 1; j <= b.size(); ++j) {
+            const size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
+            diagonal = up;
+        }
+    }
+    return row[b.size()];
+}
+
+/** Every long option name ("--out") of a command. */
+std::vector<std::string> optionNames(const CLI::App* app) {
+    std::vector<std::string> names;
+    for (const CLI::Option* o : app->get_options())
+        for (const std::string& n : o->get_lnames())
+            names.push_back("--" + n);
+    return names;
+}
+
+/**
+ * For an unknown command or option on the command line, prints "unknown ...; did you mean
+ * ...?" and returns true; false when the parse error is something else.
+ */
+bool printSuggestion(const CLI::App& app, int argc, char** argv) {
+    std::vector<std::string> commands;
+    for (const CLI::App* sub : app.get_subcommands({}))
+        commands.push_back(sub->get_name());
+    if (argc < 2) return false;
+    const std::string first = argv[1];
+    if (first.empty() || first[0] == '-') return false;
+    const auto known = std::find(commands.begin(), commands.end(), first);
+    if (known == commands.end()) {
+        const std::string near = closestMatch(first, commands);
+        std::fprintf(stderr,
+                     "gilab: error: unknown command '%s'%s\nRun 'gilab --help' for the list.\n",
+                     first.c_str(), near.empty() ? "" : ("; did you mean '" + near + "'?").c_str());
+        return true;
+    }
+    // Options of the command and of its sub-commands (bench reference, bench technique).
+    const CLI::App* command = app.get_subcommand(first);
+    std::vector<std::string> names = optionNames(command);
+    std::string where = first;
+    if (argc >= 3) {
+        for (const CLI::App* sub : command->get_subcommands({}))
+            if (sub->get_name() == argv[2]) {
+                names = optionNames(sub);
+                where += " " + sub->get_name();
+            }
+    }
+    for (int i = 2; i < argc; ++i) {
+        std::string arg = argv[i];
+        if (arg.rfind("--", 0) != 0) continue;
+        arg = arg.substr(0, arg.find('='));
+        if (std::find(names.begin(), names.end(), arg) != names.end()) continue;
+        const std::string near = closestMatch(arg, names);
+        std::fprintf(stderr,
+                     "gilab: error: unknown option '%s' for 'gilab %s'%s\nRun 'gilab %s --help' "
+                     "for its options.\n",
+                     arg.c_str(), where.c_str(),
+                     near.empty() ? "" : ("; did you mean '" + near + "'?").c_str(), where.c_str());
+        return true;
+    }
+    return false;
+}
+
+}  // namespace
+
+std::string closestMatch(const std::string& word, const std::vector<std::string>& candidates) {
+    std::string best;
+    size_t bestDistance = std::max<size_t>(2, word.size() / 3) + 1;
+    for (const std::string& c : candidates) {
+        const size_t d = editDistance(word, c);
+        if (d < bestDistance) {
+            bestDistance = d;
+            best = c;
+        }
+    }
+    return best;
+}
 
 int runMain(int argc, char** argv) {
     CLI::App app{
@@ -22,6 +116,12 @@ int runMain(int argc, char** argv) {
         "measured against a path-traced ground truth."};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Help for every command");
+    app.set_version_flag("--version", std::string("gilab ") + build::kVersion + " (" +
+                                          build::kGitCommit + ", " + build::kBuildType + ")");
+    app.footer(
+        "Documentation: docs/ (start with docs/tutorial.md). Exit codes: 0 ok, 1 error, "
+        "2 usage, 3 unsupported, 4 non-finite pixels, 5 validation messages, 130 "
+        "interrupted.");
 
     std::string commandLine;
     for (int i = 0; i < argc; ++i)
@@ -39,22 +139,23 @@ int runMain(int argc, char** argv) {
     std::string infoScene;
     bool infoJson = false;
     CLI::App* info = app.add_subcommand("scene-info", "Load a scene and print what it contains");
-    info->add_option("--scene", infoScene, "Scene description (.json[#variant]); default built-in");
+    info->add_option("--scene", infoScene, kSceneHelp);
     info->add_flag("--json", infoJson, "Machine-readable output");
 
     RenderOptions render;
     render.commandLine = commandLine;
     CLI::App* rend = app.add_subcommand(
         "render", "Render one technique on one scene: EXR layers, PNG preview, JSON sidecar");
-    rend->add_option(
-        "--scene", render.scenePath,
-        "Scene description (.json, optionally #variant); default: built-in Cornell box");
+    rend->add_option("--scene", render.scenePath, kSceneHelp);
     rend->add_option("--technique,-t", render.technique, "Technique id (see `gilab list`)")
         ->capture_default_str();
     rend->add_option("--set", render.assignments,
                      "Parameter key=value (technique) or shared.key=value (shared passes); "
                      "repeatable");
-    rend->add_option("--out,-o", render.outDir, "Output folder")->capture_default_str();
+    rend->add_option("--out,-o", render.outDir,
+                     "Output folder (default: results/render/<technique>); gets output.exr, "
+                     "final.png, indirect.png, result.json as a run folder");
+    rend->add_flag("--force", render.force, "Overwrite an existing render in the output folder");
     rend->add_option("--resolution", render.resolution, "Override the scene resolution, WxH");
     rend->add_option("--warmup", render.warmupFrames, "Warm-up frames (not timed)")
         ->check(CLI::Range(0, 1000))
@@ -72,9 +173,7 @@ int runMain(int argc, char** argv) {
     CLI::App* ref = app.add_subcommand(
         "reference",
         "Path-trace the ground truth (cached): EXR mean + stderr layers, PNG, JSON sidecar");
-    ref->add_option(
-        "--scene", reference.scenePath,
-        "Scene description (.json, optionally #variant); default: built-in Cornell box");
+    ref->add_option("--scene", reference.scenePath, kSceneHelp);
     ref->add_option("--spp", reference.spp, "Stop at this many samples per pixel")
         ->check(CLI::Range(uint64_t(1), uint64_t(1) << 40));
     ref->add_option("--rel-error", reference.relError,
@@ -106,7 +205,8 @@ int runMain(int argc, char** argv) {
     ref->add_option("--resolution", reference.resolution, "Override the scene resolution, WxH");
     CLI::Option* cacheOpt = ref->add_option(
         "--cache", reference.cacheDir,
-        "Reference cache folder (default: $GILAB_REFERENCE_CACHE or results/cache/reference)");
+        "Reference cache folder (default: $GILAB_CACHE/reference, else results/cache/reference; "
+        "docs/reference_cache.md)");
     ref->add_flag("--no-cache", reference.noCache, "Neither read nor write the cache")
         ->excludes(cacheOpt);
     ref->add_option("--out,-o", reference.outDir, "Output folder")->required();
@@ -150,8 +250,7 @@ int runMain(int argc, char** argv) {
     BenchTechniqueOptions benchTech;
     CLI::App* benchTechCmd = bench->add_subcommand(
         "technique", "Set-up and per-frame GPU times per pass of techniques (median, IQR)");
-    benchTechCmd->add_option("--scene", benchTech.scenePath,
-                             "Scene description (file.json#variant); default: built-in Cornell");
+    benchTechCmd->add_option("--scene", benchTech.scenePath, kSceneHelp);
     benchTechCmd->add_option("--technique,-t", benchTech.techniques,
                              "Technique (repeatable); default: every registered technique");
     benchTechCmd->add_option("--set", benchTech.assignments,
@@ -178,8 +277,8 @@ int runMain(int argc, char** argv) {
         ->capture_default_str();
     runCmd->add_option("--shard", shard, "Run only the slice i/N (runs whose index % N == i)");
     runCmd->add_option("--reference-cache", run.referenceCacheDir,
-                       "Reference cache folder (default: $GILAB_REFERENCE_CACHE or "
-                       "results/cache/reference)");
+                       "Reference cache folder (default: $GILAB_CACHE/reference, else "
+                       "results/cache/reference; docs/reference_cache.md)");
     runCmd->add_option("--device", run.device, "Vulkan device name substring or index");
     runCmd->add_flag("--validation", run.validation,
                      "Enable Vulkan validation layers (any message: the run is invalid, exit "
@@ -202,8 +301,9 @@ int runMain(int argc, char** argv) {
         ->required();
     compareCmd->add_option("reference", compare.reference, "Reference image: file.exr[:layer]")
         ->required();
-    compareCmd->add_option("--metrics", compare.metrics,
-                           "Comma-separated: flip,hdr-flip,relmse,psnr,ssim (default: all)")
+    compareCmd
+        ->add_option("--metrics", compare.metrics,
+                     "Comma-separated: flip,hdr-flip,relmse,psnr,ssim (default: all)")
         ->delimiter(',');
     compareCmd->add_option("--mask", compare.mask,
                            "Mask image: pool every metric over pixels whose channel 0 > 0.5");
@@ -219,7 +319,10 @@ int runMain(int argc, char** argv) {
     try {
         app.parse(argc, argv);
     } catch (const CLI::ParseError& e) {
-        return app.exit(e) == 0 ? kExitOk : kExitUsage;
+        if (e.get_exit_code() == 0) return app.exit(e) == 0 ? kExitOk : kExitUsage;  // help
+        if (printSuggestion(app, argc, argv)) return kExitUsage;
+        app.exit(e);
+        return kExitUsage;
     }
 
     try {
@@ -231,16 +334,28 @@ int runMain(int argc, char** argv) {
         if (*benchRefCmd) return runBenchReference(benchRef);
         if (*benchTechCmd) return runBenchTechnique(benchTech);
         if (*runCmd) {
-            if (!shard.empty()) std::tie(run.shardIndex, run.shardCount) = exp::parseShard(shard);
+            if (!shard.empty()) {
+                try {
+                    std::tie(run.shardIndex, run.shardCount) = exp::parseShard(shard);
+                } catch (const Error& e) {
+                    throw UsageError(e.what());
+                }
+            }
             return runExperimentCommand(run);
         }
         if (*reportCmd) return runReport(reportDirs, reportOut);
         if (*compareCmd) return runCompare(compare);
+    } catch (const UsageError& e) {
+        std::fprintf(stderr, "gilab: error: %s\n", e.what());
+        return kExitUsage;
     } catch (const Error& e) {
         std::fprintf(stderr, "gilab: error: %s\n", e.what());
         return kExitError;
+    } catch (const std::filesystem::filesystem_error& e) {
+        std::fprintf(stderr, "gilab: error: %s\n", e.what());
+        return kExitError;
     } catch (const std::exception& e) {
-        std::fprintf(stderr, "gilab: internal error: %s\n", e.what());
+        std::fprintf(stderr, "gilab: error: %s\n", e.what());
         return kExitError;
     }
     return kExitUsage;
@@ -255,7 +370,7 @@ void applyResolutionOverride(Scene& scene, const std::string& text) {
                     std::from_chars(text.data() + x + 1, text.data() + text.size(), h).ptr ==
                         text.data() + text.size();
     if (!ok || w < 1 || h < 1 || w > 16384 || h > 16384)
-        throw Error("--resolution \"" + text + "\": expected WxH with 1 <= W, H <= 16384");
+        throw UsageError("--resolution \"" + text + "\": expected WxH with 1 <= W, H <= 16384");
     scene.settings.width = w;
     scene.settings.height = h;
 }

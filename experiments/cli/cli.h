@@ -11,6 +11,7 @@
 
 #include "core/params/params.h"
 #include "core/scene/scene.h"
+#include "core/util/error.h"
 
 namespace gilab::cli {
 
@@ -24,6 +25,15 @@ enum ExitCode : int {
     kExitInvalid = 5,      // validation was on and reported an error or warning (messages saved)
 };
 
+/** A bad command line (exit code 2), thrown by the commands' own argument checks. */
+class UsageError : public Error {
+public:
+    using Error::Error;
+};
+
+/** The closest of `candidates` to `word` (edit distance), or "" when none is close. */
+std::string closestMatch(const std::string& word, const std::vector<std::string>& candidates);
+
 /** The exit code of a run with this status ("ok", "nonfinite", "unsupported", "invalid"). */
 int exitCodeForStatus(const std::string& status);
 /** The exit code of `gilab run` after all its runs: interrupted, then invalid, then nonfinite. */
@@ -36,8 +46,9 @@ struct RenderOptions {
     std::string scenePath;  // "" = the built-in Cornell box; "file.json#variant" selects a variant
     std::string technique = "direct";
     std::vector<std::string> assignments;  // "key=value" or "shared.key=value"
-    std::string outDir = "results/render";
-    std::string resolution;  // "WxH", "" = the scene's
+    std::string outDir;                    // "" = results/render/<technique>
+    bool force = false;                    // overwrite an existing output
+    std::string resolution;                // "WxH", "" = the scene's
     int warmupFrames = 1;
     int frames = 3;
     std::string device;

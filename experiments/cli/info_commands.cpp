@@ -23,7 +23,7 @@ int runDevices(const std::string& device) {
 }
 
 Scene loadSceneOrDefault(const std::string& path) {
-    return path.empty() ? makeBuiltinDefaultScene() : loadSceneFile(path);
+    return loadScene(path);
 }
 
 int runSceneInfo(const std::string& scenePath, bool json) {

@@ -93,8 +93,12 @@ int runReference(const ReferenceOptions& options) {
     settings.seed = options.seed;
     settings.batchSamples = options.batchSamples;
     ref::StopCriteria stop{options.spp, options.relError, options.seconds};
-    if (stop.maxSamples == 0 && stop.targetRelError <= 0.0 && stop.maxSeconds <= 0.0)
+    if (stop.maxSamples == 0 && stop.targetRelError <= 0.0 && stop.maxSeconds <= 0.0) {
         stop.maxSamples = 64;
+        std::fprintf(stderr,
+                     "gilab: reference: no stop criterion given (--spp, --rel-error, --time); "
+                     "using the default --spp 64\n");
+    }
 
     Image longReference;
     if (!options.longReference.empty())
@@ -137,7 +141,7 @@ int runReference(const ReferenceOptions& options) {
         finite = finiteJson(layers, &nonFinite);
         for (ImageLayer& l : ref::stdErrorLayers(r.acc))
             layers.push_back(std::move(l));
-        writeExrLayers(base + ".exr", layers);
+        writeExrWithMainImage(base + ".exr", layers, "full");
         ToneMap tm;
         tm.exposureEv = scene.settings.exposureEv;
         writePngTonemapped(base + ".png", layers.front().image, tm);

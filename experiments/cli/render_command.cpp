@@ -1,4 +1,5 @@
-// `gilab render`: one technique, one scene -> <out>/<technique>.exr/.png/.json
+// `gilab render`: one technique, one scene -> <out>/output.exr, final.png, indirect.png,
+// result.json (the file names of a `gilab run` folder)
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -21,11 +22,17 @@ namespace gilab::cli {
 void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
                       ParamSet& shared) {
     for (const std::string& a : assignments) {
-        auto [key, value] = splitAssignment(a);
-        if (key.rfind("shared.", 0) == 0)
-            shared.set(key.substr(7), value);
-        else
-            technique.set(key, value);
+        try {
+            auto [key, value] = splitAssignment(a);
+            if (key.rfind("shared.", 0) == 0)
+                shared.set(key.substr(7), value);
+            else
+                technique.set(key, value);
+        } catch (const UsageError&) {
+            throw;
+        } catch (const Error& e) {
+            throw UsageError("--set " + a + ": " + e.what());  // a bad command line: exit 2
+        }
     }
 }
 
@@ -79,9 +86,15 @@ int runRender(const RenderOptions& options) {
     ctxOptions.deviceFilter = options.device;
     vk::Context ctx(ctxOptions);
 
-    const std::filesystem::path outDir(options.outDir);
+    const std::filesystem::path outDir(
+        options.outDir.empty() ? "results/render/" + options.technique : options.outDir);
+    const std::filesystem::path exrPath = outDir / "output.exr";
+    const std::filesystem::path jsonFile = outDir / "result.json";
+    if (!options.force && (std::filesystem::exists(exrPath) || std::filesystem::exists(jsonFile)))
+        throw Error(outDir.string() +
+                    " already holds a render (output.exr / result.json); pass --force to "
+                    "overwrite it, or choose another --out");
     std::filesystem::create_directories(outDir);
-    const std::filesystem::path base = outDir / options.technique;
 
     nlohmann::ordered_json meta;
     meta["status"] = "running";
@@ -94,7 +107,7 @@ int runRender(const RenderOptions& options) {
         {"params", params.toOrderedJson()}};
     meta["shared_params"] = shared.toOrderedJson();
 
-    const std::string jsonPath = base.string() + ".json";
+    const std::string jsonPath = jsonFile.string();
     // Destroyed before the validation messages are collected, so they include its teardown.
     auto harness = std::make_unique<FrameHarness>(ctx, scene, options.technique, params, shared);
     if (!harness->support().supported) {
@@ -130,11 +143,13 @@ int runRender(const RenderOptions& options) {
     meta["notes"] = harness->notes();
     harness.reset();
 
-    writeExrLayers(base.string() + ".exr", layers);
+    writeExrWithMainImage(exrPath.string(), layers, "final");
     ToneMap tm;
     tm.exposureEv = scene.settings.exposureEv;
-    writePngTonemapped(base.string() + ".png", layers.front().image, tm);
-    meta["outputs"] = {{"exr", base.string() + ".exr"}, {"png", base.string() + ".png"}};
+    writePngTonemapped((outDir / "final.png").string(), layers.front().image, tm);
+    writePngTonemapped((outDir / "indirect.png").string(), layers[1].image, tm);
+    meta["outputs"] = {
+        {"exr", "output.exr"}, {"final_png", "final.png"}, {"indirect_png", "indirect.png"}};
     const std::string status =
         finishSidecar(ctx, meta, jsonPath, {.supported = true, .nonFinitePixels = nonFinite});
 
@@ -149,11 +164,12 @@ int runRender(const RenderOptions& options) {
         gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
     for (const auto& skipped : meta["skipped_passes"])
         std::printf("  skipped %s\n", skipped.get<std::string>().c_str());
-    std::printf("  wrote %s.{exr,png,json}\n", base.string().c_str());
+    std::printf("  wrote %s/{output.exr,final.png,indirect.png,result.json}\n",
+                outDir.string().c_str());
     if (nonFinite)
         std::fprintf(stderr,
-                     "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s.json)\n",
-                     nonFinite, base.string().c_str());
+                     "gilab: %zu non-finite pixels in the outputs (see \"nonfinite\" in %s)\n",
+                     nonFinite, jsonPath.c_str());
     reportValidation(meta["validation"], jsonPath);
     return exitCodeForStatus(status);
 }

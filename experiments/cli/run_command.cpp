@@ -40,15 +40,40 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
     return runExitCode(s, interrupt.interrupted());
 }
 
+/**
+ * The report code, relative to the running binary: GILAB_REPORT_SCRIPT, else
+ * <bin>/../share/gilab/report/make_report.py (installed), else <bin>/../scripts/report/ (a build
+ * folder inside the source tree), else the source tree the binary was built from.
+ */
+static std::string findReportScript() {
+    if (const char* env = std::getenv("GILAB_REPORT_SCRIPT"); env && *env) {
+        if (!std::filesystem::exists(env))
+            throw Error("report: GILAB_REPORT_SCRIPT=" + std::string(env) + " does not exist");
+        return env;
+    }
+    std::error_code ec;
+    const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+    std::vector<std::filesystem::path> tried;
+    if (!ec) {
+        const std::filesystem::path bin = exe.parent_path();
+        tried.push_back(bin / ".." / "share" / "gilab" / "report" / "make_report.py");
+        tried.push_back(bin / ".." / "scripts" / "report" / "make_report.py");
+    }
+    tried.push_back(std::filesystem::path(build::kSourceDir) / "scripts" / "report" /
+                    "make_report.py");
+    std::string list;
+    for (const auto& p : tried) {
+        if (std::filesystem::exists(p)) return p.lexically_normal().string();
+        list += (list.empty() ? "" : ", ") + p.lexically_normal().string();
+    }
+    throw Error("report: cannot find make_report.py (looked in " + list +
+                "); install with `cmake --install` or set GILAB_REPORT_SCRIPT");
+}
+
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
     for (const std::string& d : dirs)
         if (!std::filesystem::is_directory(d)) throw Error("report: no such results folder: " + d);
-    const char* env = std::getenv("GILAB_REPORT_SCRIPT");
-    const std::string script =
-        env && *env ? env : std::string(build::kSourceDir) + "/scripts/report/make_report.py";
-    if (!std::filesystem::exists(script))
-        throw Error("report: the report script is missing: " + script +
-                    " (set GILAB_REPORT_SCRIPT to its path)");
+    const std::string script = findReportScript();
     const char* python = "/usr/bin/python3";  // Debian's, with python3-matplotlib
     std::vector<std::string> args{python, script};
     args.insert(args.end(), dirs.begin(), dirs.end());

@@ -102,4 +102,21 @@ nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers
     return out;
 }
 
+nlohmann::ordered_json computeDirectMetrics(const std::vector<ImageLayer>& layers,
+                                            const MatchedReference& directReference,
+                                            const MetricOptionsSpec& spec, const ToneMap& tonemap) {
+    // The light every technique shares: its emission + direct against the reference's.
+    const Image& direct = layerImage(layers, "direct");
+    const Image& emission = layerImage(layers, "emission");
+    Image sum = direct;
+    for (size_t i = 0; i < sum.values().size(); ++i)
+        sum.values()[i] += emission.values()[i];
+    metrics::MetricOptions options;
+    options.tonemap = tonemap;
+    options.ppd = spec.ppd;
+    options.resampleFlip = false;
+    options.referenceStdError = &directReference.finalStdError;
+    return metrics::toJson(metrics::computeMetrics(sum, directReference.final, options));
+}
+
 }  // namespace gilab::exp

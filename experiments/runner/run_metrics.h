@@ -31,4 +31,12 @@ nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers
                                            const ReferenceSet& references,
                                            const MetricOptionsSpec& spec, const ToneMap& tonemap);
 
+/**
+ * The light every technique shares: its emission + direct layers against the reference's
+ * emission + direct (`directReference` = ReferenceSet::match(0)). metrics::toJson(MetricSet).
+ */
+nlohmann::ordered_json computeDirectMetrics(const std::vector<ImageLayer>& layers,
+                                            const MatchedReference& directReference,
+                                            const MetricOptionsSpec& spec, const ToneMap& tonemap);
+
 }  // namespace gilab::exp

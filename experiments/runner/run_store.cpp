@@ -7,6 +7,8 @@
 #include <cctype>
 #include <fstream>
 #include <sstream>
+#include <unordered_map>
+#include <unordered_set>
 
 #include "core/util/error.h"
 
@@ -49,53 +51,122 @@ std::string sanitizeLabel(const std::string& label) {
     return out;
 }
 
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+/** r at `path`, or null. */
+Json jsonAt(const Json& r, std::initializer_list<const char*> path) {
+    const Json* node = &r;
+    for (const char* key : path) {
+        if (!node->is_object() || !node->contains(key)) return nullptr;
+        node = &(*node)[key];
+    }
+    return *node;
+}
+
+/** The headline numbers of one metrics::toJson() result, under `prefix`. */
+void addMetricColumns(Json& row, const std::string& prefix, const Json& m) {
+    if (!m.is_object()) return;
+    const Json bars = jsonAt(m, {"error_bars"});
+    row[prefix + ".flip"] = jsonAt(m, {"flip", "mean"});
+    row[prefix + ".flip_noise"] = jsonAt(bars, {"flip", "spread"});
+    row[prefix + ".flip_ldr"] = jsonAt(m, {"flip_ldr", "mean"});
+    row[prefix + ".rel_mse"] = jsonAt(m, {"rel_mse"});
+    row[prefix + ".rel_mse_sigma"] = jsonAt(bars, {"rel_mse_sigma"});
+    row[prefix + ".rel_mse_noise_floor"] = jsonAt(bars, {"rel_mse_noise_floor"});
+    row[prefix + ".rel_mse_debiased"] = jsonAt(bars, {"rel_mse_debiased"});
+    row[prefix + ".psnr_ldr"] = jsonAt(m, {"psnr_ldr"});
+    row[prefix + ".psnr_hdr"] = jsonAt(m, {"psnr_hdr"});
+    row[prefix + ".ssim"] = jsonAt(m, {"ssim"});
+    row[prefix + ".within_reference_noise"] = jsonAt(m, {"within_reference_noise"});
+}
+
+/** NaN / Inf / negative pixels summed over every output layer. */
+void addNonFiniteColumns(Json& row, const Json& nonfinite) {
+    if (!nonfinite.is_object()) return;
+    long long nan = 0, inf = 0, negative = 0;
+    for (const auto& [layer, counts] : nonfinite.items()) {
+        if (!counts.is_object()) continue;
+        nan += counts.value("nan_pixels", 0LL);
+        inf += counts.value("inf_pixels", 0LL);
+        negative += counts.value("negative_pixels", 0LL);
+    }
+    row["nan_pixels"] = nan;
+    row["inf_pixels"] = inf;
+    row["negative_pixels"] = negative;
+}
+
+}  // namespace
+
 nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
-    auto at = [&](std::initializer_list<const char*> path) -> nlohmann::ordered_json {
-        const nlohmann::ordered_json* node = &r;
-        for (const char* key : path) {
-            if (!node->is_object() || !node->contains(key)) return nullptr;
-            node = &(*node)[key];
-        }
-        return *node;
-    };
-    std::string params;
-    if (r.contains("technique") && r["technique"].contains("params"))
-        for (const auto& [k, v] : r["technique"]["params"].items())
-            params += (params.empty() ? "" : " ") + k + "=" +
-                      (v.is_string() ? v.get<std::string>() : v.dump());
-    return {{"key", at({"key"})},
-            {"index", at({"index"})},
-            {"experiment", at({"experiment"})},
-            {"scene", at({"scene", "label"})},
-            {"technique", at({"technique", "id"})},
-            {"bounces", at({"technique", "indirect_bounces"})},
-            {"params", params},
-            {"status", at({"status"})},
-            {"reason", at({"reason"})},
-            {"validation_errors", at({"validation", "errors"})},
-            {"validation_warnings", at({"validation", "warnings"})},
-            {"setup_ms", at({"timing", "setup_ms", "total"})},
-            {"frame_cpu_ms_median", at({"timing", "frame_cpu_ms", "median"})},
-            {"frame_cpu_ms_iqr", at({"timing", "frame_cpu_ms", "iqr"})},
-            {"frame_gpu_ms_median", at({"timing", "frame_gpu_ms", "median"})},
-            {"memory_bytes", at({"memory", "total_bytes"})},
-            {"reference_matched", at({"reference", "matched"})},
-            {"reference_samples", at({"reference", "samples"})},
-            {"psnr_ldr", at({"metrics", "final", "psnr_ldr"})},
-            {"rel_mse", at({"metrics", "final", "rel_mse"})},
-            {"ssim", at({"metrics", "final", "ssim"})},
-            {"flip_mean", at({"metrics", "final", "flip", "mean"})},
-            {"within_reference_noise", at({"metrics", "final", "within_reference_noise"})},
-            {"flip_mean_vs_full", at({"metrics", "final_vs_full", "flip", "mean"})},
-            {"energy_ratio", at({"metrics", "energy_ratio"})},
-            {"nan_pixels_final", at({"nonfinite", "final", "nan_pixels"})},
-            {"inf_pixels_final", at({"nonfinite", "final", "inf_pixels"})},
-            {"device", at({"device", "name"})},
-            {"driver", at({"device", "driver_info"})},
-            {"vulkan_api", at({"device", "vulkan_api"})},
-            {"config_hash", at({"config_hash"})},
-            {"git_commit", at({"provenance", "git_commit"})},
-            {"date", at({"provenance", "date"})}};
+    auto at = [&](std::initializer_list<const char*> path) { return jsonAt(r, path); };
+    Json row = {{"key", at({"key"})},
+                {"index", at({"index"})},
+                {"experiment", at({"experiment"})},
+                {"scene", at({"scene", "label"})},
+                {"technique", at({"technique", "id"})},
+                {"bounces", at({"technique", "indirect_bounces"})},
+                {"status", at({"status"})},
+                {"reason", at({"reason"})}};
+    // One column per parameter (technique: param.<key>; shared passes: shared.<key>), the
+    // swept keys, and the compact "params" text of the technique's parameters.
+    std::string params, swept;
+    // Named copies: a temporary's items() would dangle in a range-for (before C++23).
+    const Json techniqueParams = at({"technique", "params"}), sharedParams = at({"shared_params"}),
+               sweptKeys = at({"technique", "swept"}), ladder = at({"metrics", "final_vs_bounces"}),
+               regions = at({"metrics", "regions"});
+    for (const auto& [k, v] : techniqueParams.items()) {
+        row["param." + k] = v;
+        params += (params.empty() ? "" : " ") + k + "=" +
+                  (v.is_string() ? v.get<std::string>() : v.dump());
+    }
+    for (const auto& [k, v] : sharedParams.items())
+        row["shared." + k] = v;
+    for (const auto& [k, v] : sweptKeys.items())
+        swept += (swept.empty() ? "" : " ") + k;
+    row["params"] = params;
+    row["swept"] = swept;
+    row["validation_errors"] = at({"validation", "errors"});
+    row["validation_warnings"] = at({"validation", "warnings"});
+    row["setup_ms"] = at({"timing", "setup_ms", "total"});
+    row["frame_cpu_ms_median"] = at({"timing", "frame_cpu_ms", "median"});
+    row["frame_cpu_ms_iqr"] = at({"timing", "frame_cpu_ms", "iqr"});
+    row["frame_gpu_ms_median"] = at({"timing", "frame_gpu_ms", "median"});
+    row["frame_gpu_ms_iqr"] = at({"timing", "frame_gpu_ms", "iqr"});
+    row["memory_bytes"] = at({"memory", "total_bytes"});
+    row["reference_matched"] = at({"reference", "matched"});
+    row["reference_samples"] = at({"reference", "samples"});
+    row["reference_rel_error"] = at({"reference", "rel_error"});
+    // Every basis the report shows (docs/experiments.md "Result tables"): full = all light
+    // paths (the headline), matched = the bounces the technique claims, indirect, direct.
+    addMetricColumns(row, "full", at({"metrics", "final_vs_full"}));
+    addMetricColumns(row, "matched", at({"metrics", "final"}));
+    addMetricColumns(row, "indirect", at({"metrics", "indirect"}));
+    addMetricColumns(row, "direct", at({"metrics", "direct"}));
+    row["energy_ratio"] = at({"metrics", "energy_ratio"});
+    for (const auto& [n, m] : ladder.items())
+        addMetricColumns(row, "bounces" + n, m);
+    for (const auto& [name, region] : regions.items()) {
+        const std::string prefix = "region." + name;
+        row[prefix + ".pixels"] = jsonAt(region, {"pixels"});
+        row[prefix + ".energy_ratio"] = jsonAt(region, {"energy_ratio"});
+        addMetricColumns(row, prefix + ".matched", jsonAt(region, {"final"}));
+        addMetricColumns(row, prefix + ".indirect", jsonAt(region, {"indirect"}));
+    }
+    addNonFiniteColumns(row, at({"nonfinite"}));
+    row["output_exr"] = at({"outputs", "exr"}).is_string()
+                            ? Json("runs/" + at({"key"}).get<std::string>() + "/" +
+                                   at({"outputs", "exr"}).get<std::string>())
+                            : Json(nullptr);
+    row["device"] = at({"device", "name"});
+    row["device_type"] = at({"device", "type"});
+    row["driver"] = at({"device", "driver_info"});
+    row["vulkan_api"] = at({"device", "vulkan_api"});
+    row["config_hash"] = at({"config_hash"});
+    row["git_commit"] = at({"provenance", "git_commit"});
+    row["date"] = at({"provenance", "date"});
+    return row;
 }
 
 bool isFinalStatus(const std::string& status) {
@@ -112,7 +183,7 @@ std::string runStatus(const RunOutcome& outcome) {
     return outcome.nonFinitePixels > 0 ? "nonfinite" : "ok";
 }
 
-void flattenJson(const nlohmann::json& value, const std::string& prefix,
+void flattenJson(const nlohmann::ordered_json& value, const std::string& prefix,
                  std::vector<std::pair<std::string, std::string>>& out) {
     if (value.is_object()) {
         for (const auto& [k, v] : value.items())
@@ -174,38 +245,47 @@ void RunStore::commitRun(const fs::path& tmpDir, const std::string& key) const {
 
 void RunStore::appendRow(const nlohmann::ordered_json& row) const {
     appendLine(m_dir / "results.jsonl", row.dump());
+    writeCsv();
+}
 
-    std::vector<std::pair<std::string, std::string>> cells;
-    flattenJson(row, "", cells);
-    const fs::path csv = m_dir / "results.csv";
-    // The header is written once, from the first row; later rows follow its columns (a column
-    // the first row lacked is dropped from the CSV but kept in results.jsonl).
+void RunStore::writeCsv() const {
+    // results.csv is derived from results.jsonl (the append-only record): its columns are the
+    // union over every row in first-seen order, so runs of different techniques (different
+    // parameters) each keep all their columns. Rewritten atomically after every row.
+    std::vector<std::vector<std::pair<std::string, std::string>>> rows;
     std::vector<std::string> header;
-    if (fs::exists(csv)) {
-        std::ifstream in(csv);
-        std::string line;
-        std::getline(in, line);
-        std::stringstream ss(line);
-        std::string cell;
-        while (std::getline(ss, cell, ','))
-            header.push_back(cell);
-    } else {
-        std::string line;
-        for (const auto& [k, v] : cells) {
-            header.push_back(k);
-            if (!line.empty()) line += ',';
-            line += csvEscape(k);
-        }
-        appendLine(csv, line);
-    }
+    std::unordered_set<std::string> seen;
+    std::ifstream in(m_dir / "results.jsonl");
     std::string line;
-    for (size_t i = 0; i < header.size(); ++i) {
-        auto it = std::find_if(cells.begin(), cells.end(),
-                               [&](const auto& c) { return c.first == header[i]; });
-        if (i) line += ',';
-        if (it != cells.end()) line += csvEscape(it->second);
+    while (std::getline(in, line)) {
+        if (line.empty()) continue;
+        nlohmann::ordered_json row;
+        try {
+            row = nlohmann::ordered_json::parse(line);
+        } catch (const std::exception&) {
+            continue;  // a torn last line of a killed run: the run is redone anyway
+        }
+        rows.emplace_back();
+        flattenJson(row, "", rows.back());
+        for (const auto& [k, v] : rows.back())
+            if (seen.insert(k).second) header.push_back(k);
     }
-    appendLine(csv, line);
+    std::string out;
+    for (size_t i = 0; i < header.size(); ++i)
+        out += (i ? "," : "") + csvEscape(header[i]);
+    out += "\n";
+    for (const auto& cells : rows) {
+        std::unordered_map<std::string, const std::string*> byKey;
+        for (const auto& [k, v] : cells)
+            byKey[k] = &v;
+        for (size_t i = 0; i < header.size(); ++i) {
+            if (i) out += ',';
+            auto it = byKey.find(header[i]);
+            if (it != byKey.end()) out += csvEscape(*it->second);
+        }
+        out += "\n";
+    }
+    writeFileAtomic(m_dir / "results.csv", out);
 }
 
 std::vector<nlohmann::json> RunStore::loadFinished() const {

@@ -39,8 +39,10 @@ public:
     /** Moves the temporary folder to runs/<key>/ (atomic rename). */
     void commitRun(const std::filesystem::path& tmpDir, const std::string& key) const;
 
-    /** Appends one row to results.jsonl and results.csv (flushed and synced). */
+    /** Appends one row to results.jsonl (flushed and synced) and rewrites results.csv. */
     void appendRow(const nlohmann::ordered_json& row) const;
+    /** results.csv from results.jsonl: one column per key of any row (atomic rewrite). */
+    void writeCsv() const;
 
     /** Every stored run's result.json (final or invalid), sorted by run index then key. */
     std::vector<nlohmann::json> loadFinished() const;
@@ -68,7 +70,7 @@ struct RunOutcome {
 std::string runStatus(const RunOutcome& outcome);
 
 /** Flattens nested objects to "a.b.c" columns for CSV (arrays are JSON-encoded in one cell). */
-void flattenJson(const nlohmann::json& value, const std::string& prefix,
+void flattenJson(const nlohmann::ordered_json& value, const std::string& prefix,
                  std::vector<std::pair<std::string, std::string>>& out);
 
 /** A label safe as a folder name: letters, digits, '-', '_' kept; everything else -> '_'. */

@@ -1,5 +1,6 @@
 #include "experiments/runner/runner.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -30,7 +31,7 @@ namespace fs = std::filesystem;
 namespace {
 
 /** Bumped when the meaning of a run's result changes, so finished runs are redone. */
-constexpr int kRunFormatVersion = 2;  // 2: metrics.final_vs_bounces
+constexpr int kRunFormatVersion = 2;  // 2: metrics.final_vs_bounces (metrics.direct is additive)
 
 /** Loads each scene of the experiment once, applying the config's resolution. */
 class SceneCache {
@@ -38,9 +39,9 @@ public:
     const Scene& get(const SceneEntry& entry) {
         auto it = m_scenes.find(entry.label);
         if (it != m_scenes.end()) return *it->second;
-        auto scene =
-            std::make_unique<Scene>(entry.path.empty() ? makeBuiltinDefaultScene()
-                                                       : loadSceneFile(entry.path, entry.variant));
+        auto scene = std::make_unique<Scene>(entry.variant.empty()
+                                                 ? loadScene(entry.path)
+                                                 : loadSceneFile(entry.path, entry.variant));
         if (entry.width > 0) {
             scene->settings.width = entry.width;
             scene->settings.height = entry.height;
@@ -101,21 +102,50 @@ const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scen
                 .first->second;
 }
 
-/** references/<label>/<matched>.{exr,png}: written once per experiment folder. */
+/**
+ * references/<label>/: the matched reference <matched>.{exr,png}, the full reference
+ * full.{exr,png}, and the indirect light the run's `indirect` layer is compared with,
+ * indirect_<bounces>.png (e.g. indirect_bounce1.png; indirect_full.png = all indirect light).
+ * Each file is written once per experiment folder. Returns the paths relative to a run folder.
+ */
 nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry,
                                              const MatchedReference& m, const ToneMap& tm) {
     const std::string safeLabel = sanitizeLabel(entry.label);
     const fs::path dir = c.store.dir() / "references" / safeLabel;
-    const fs::path png = dir / (m.name + ".png"), exr = dir / (m.name + ".exr");
-    const std::string id = safeLabel + "/" + m.name;
-    if (!c.writtenReferencePreviews[id]) {
+    const std::string rel = "../../references/" + safeLabel + "/";
+    auto once = [&](const std::string& file, const auto& write) {
+        const std::string id = safeLabel + "/" + file;
+        if (c.writtenReferencePreviews[id]) return;
         fs::create_directories(dir);
-        writeExrLayers(exr.string(), {{"final", m.final}, {"final_stderr", m.finalStdError}});
-        writePngTonemapped(png.string(), m.final, tm);
+        write((dir / file).string());
         c.writtenReferencePreviews[id] = true;
+    };
+    auto exr = [&](const std::string& file, const Image& mean, const Image& stdError) {
+        once(file, [&](const std::string& path) {
+            writeExrWithMainImage(path, {{"final", mean}, {"final_stderr", stdError}}, "final");
+        });
+    };
+    auto png = [&](const std::string& file, const Image& image) {
+        once(file, [&](const std::string& path) { writePngTonemapped(path, image, tm); });
+    };
+    exr(m.name + ".exr", m.final, m.finalStdError);
+    png(m.name + ".png", m.final);
+    exr("full.exr", m.full, m.fullStdError);
+    png("full.png", m.full);
+    png("indirect_full.png", m.fullIndirect);
+    nlohmann::ordered_json out = {{"final_png", rel + m.name + ".png"},
+                                  {"final_exr", rel + m.name + ".exr"},
+                                  {"full_png", rel + "full.png"},
+                                  {"full_exr", rel + "full.exr"},
+                                  {"indirect_full_png", rel + "indirect_full.png"}};
+    if (!m.indirect.empty()) {
+        const std::string prefix = "emission+direct+";
+        const std::string bounces =
+            m.name.rfind(prefix, 0) == 0 ? m.name.substr(prefix.size()) : m.name;
+        png("indirect_" + bounces + ".png", m.indirect);
+        out["indirect_png"] = rel + "indirect_" + bounces + ".png";
     }
-    return {{"final_png", "../../references/" + safeLabel + "/" + m.name + ".png"},
-            {"final_exr", "../../references/" + safeLabel + "/" + m.name + ".exr"}};
+    return out;
 }
 
 /** Prints where the messages of an invalid run are (the first ones went to stderr already). */
@@ -130,6 +160,31 @@ void reportInvalid(const nlohmann::ordered_json& result, const fs::path& runDir)
                  v["warnings"].get<uint32_t>(), (runDir / "result.json").string().c_str());
 }
 
+/** One line per finished run on stdout, also when it is not a terminal (batch logs). */
+void printRunLine(const nlohmann::ordered_json& row, bool quiet) {
+    if (quiet) return;
+    auto number = [&](const char* key) {
+        return row.contains(key) && row[key].is_number() ? row[key].get<double>() : -1.0;
+    };
+    std::string line = "run " + std::to_string(row.value("index", 0)) + " " +
+                       row.value("technique", "") + " on " + row.value("scene", "") + ": " +
+                       row.value("status", "");
+    char buf[160];
+    if (number("full.flip") >= 0.0) {
+        std::snprintf(buf, sizeof buf, ", HDR-FLIP vs full %.3f, relMSE vs full %.4f",
+                      number("full.flip"), number("full.rel_mse"));
+        line += buf;
+    }
+    if (number("frame_gpu_ms_median") >= 0.0) {
+        std::snprintf(buf, sizeof buf, ", frame %.2f ms (%s)", number("frame_gpu_ms_median"),
+                      row.value("device_type", "") == "cpu" ? "lavapipe, CPU" : "GPU");
+        line += buf;
+    }
+    const std::string params = row.value("params", "");
+    std::printf("%s%s%s\n", line.c_str(), params.empty() ? "" : "  ", params.c_str());
+    std::fflush(stdout);
+}
+
 /**
  * Adds the run's validation messages and final status to `result`, writes result.json, commits
  * the run folder and appends its row. Returns the status.
@@ -141,8 +196,10 @@ std::string commitResult(Context& c, nlohmann::ordered_json& result, const fs::p
     result["status"] = runStatus(outcome);
     writeFileAtomic(tmp / "result.json", result.dump(2));
     c.store.commitRun(tmp, key);
-    c.store.appendRow(resultRow(result));
+    const nlohmann::ordered_json row = resultRow(result);
+    c.store.appendRow(row);
     if (result["status"] == "invalid") reportInvalid(result, c.store.runDir(key));
+    printRunLine(row, c.options.quiet);
     return result["status"];
 }
 
@@ -220,8 +277,9 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["metrics"] = computeRunMetrics(layers, matched, claimedBounces(info, run.params),
                                           c.config.metrics, tm, tmp);
     result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
+    result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
 
-    writeExrLayers((tmp / "output.exr").string(), layers);
+    writeExrWithMainImage((tmp / "output.exr").string(), layers, "final");
     writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
     writePngTonemapped((tmp / "indirect.png").string(), layers[1].image, tm);
     result["outputs"] = {{"exr", "output.exr"},
@@ -236,6 +294,38 @@ const char* dryRunState(const RunStore& store, const std::string& key) {
     const std::string status = store.storedStatus(key);
     if (isFinalStatus(status)) return "[done]";
     return status == "invalid" ? "[todo: invalid]" : "[todo]";
+}
+
+/** The runs as a table with the parameter columns of results.csv (param.*, shared.*). */
+void printDryRun(const std::vector<const RunSpec*>& runs, const std::vector<std::string>& keys,
+                 const RunStore& store) {
+    std::vector<std::string> columns;
+    std::vector<std::map<std::string, std::string>> cells(runs.size());
+    auto add = [&](size_t row, const std::string& column, const nlohmann::ordered_json& v) {
+        if (std::find(columns.begin(), columns.end(), column) == columns.end())
+            columns.push_back(column);
+        cells[row][column] = v.is_string() ? v.get<std::string>() : v.dump();
+    };
+    for (size_t i = 0; i < runs.size(); ++i) {
+        for (const auto& [k, v] : runs[i]->params.toOrderedJson().items())
+            add(i, "param." + k, v);
+        for (const auto& [k, v] : runs[i]->shared.toOrderedJson().items())
+            add(i, "shared." + k, v);
+    }
+    std::printf("index\tkey\tstate\tscene\ttechnique");
+    for (const std::string& c : columns)
+        std::printf("\t%s", c.c_str());
+    std::printf("\n");
+    for (size_t i = 0; i < runs.size(); ++i) {
+        std::printf("%zu\t%s\t%s\t%s\t%s", runs[i]->index, keys[i].substr(0, 12).c_str(),
+                    dryRunState(store, keys[i]), runs[i]->scene->label.c_str(),
+                    runs[i]->techniqueId.c_str());
+        for (const std::string& c : columns) {
+            auto it = cells[i].find(c);
+            std::printf("\t%s", it == cells[i].end() ? "" : it->second.c_str());
+        }
+        std::printf("\n");
+    }
 }
 
 }  // namespace
@@ -284,11 +374,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
     for (const RunSpec* r : mine)
         keys.push_back(hashHex128(runIdentity(config, *r, probeScenes.get(*r->scene)).dump()));
     if (options.dryRun) {
-        for (size_t i = 0; i < mine.size(); ++i)
-            std::printf("%4zu %s %-12s %-24s %s %s\n", mine[i]->index,
-                        keys[i].substr(0, 12).c_str(), mine[i]->techniqueId.c_str(),
-                        mine[i]->scene->label.c_str(), mine[i]->params.toString().c_str(),
-                        dryRunState(store, keys[i]));
+        printDryRun(mine, keys, store);
         return summary;
     }
 

@@ -21,10 +21,11 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import report_figures  # noqa: E402
-from report_analysis import (MATCHED, ONE_BOUNCE, Basis, by_scene, by_technique,  # noqa: E402
-                             best_run, find_sweeps, has_one_bounce, pareto_fronts, pass_colors, ranking_basis, slug,
-                             technique_colors)
-from report_data import Results, load_results  # noqa: E402
+from report_analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,  # noqa: E402
+                             best_runs, by_scene, find_sweeps, has_one_bounce, pareto_fronts,
+                             pareto_ties, pass_colors, scene_basis, slug, technique_colors)
+from report_noop import no_effect  # noqa: E402
+from report_data import Results, Run, load_results  # noqa: E402
 from report_common import Figures, Page  # noqa: E402
 from report_html import render_page  # noqa: E402
 
@@ -58,8 +59,15 @@ def clear_old_figures(fig_dir: str) -> None:
 BASELINE_TECHNIQUE = "direct"
 
 
-def write_figures(results: Results, colors: dict[str, str], bases: list[Basis],
-                  fig_dir: str) -> Figures:
+def figure_bases(runs: list[Run]) -> list[Basis]:
+    """The rows of a scene's error-vs-time figure: its headline basis first (the full reference
+    when measured), then the bounce-matched view, then the one-bounce one where it applies."""
+    headline = scene_basis(runs)
+    bases = [headline] + ([MATCHED] if headline is FULL else [])
+    return bases + ([ONE_BOUNCE] if has_one_bounce(runs) else [])
+
+
+def write_figures(results: Results, colors: dict[str, str], fig_dir: str) -> Figures:
     """Draws every figure that applies; returns their paths."""
     figures = Figures()
     runs = results.runs
@@ -69,26 +77,32 @@ def write_figures(results: Results, colors: dict[str, str], bases: list[Basis],
     clear_old_figures(fig_dir)
     report_figures.configure()
     passes = pass_colors([name for r in runs for name, _ in r.passes()], colors)
-    for scene, scene_runs in by_scene(runs).items():
+    scenes = by_scene(runs)
+    for scene, scene_runs in scenes.items():
         timed = [r for r in scene_runs if r.measured and r.frame_ms is not None]
         if timed:
             path = os.path.join(fig_dir, f"pareto_{slug(scene)}.svg")
-            report_figures.pareto_figure(scene_runs, colors, bases, path, scene)
+            report_figures.pareto_figure(scene_runs, colors, figure_bases(scene_runs), path,
+                                         scene)
             figures.pareto[scene] = path
-        best = [b for b in (best_run(rs) for rs in by_technique(scene_runs).values()) if b]
+        best = best_runs(scene_runs, scene_basis(scene_runs))
         if any(v for b in best for _, v in b.passes() + b.setup_stages()):
             path = os.path.join(fig_dir, f"passes_{slug(scene)}.svg")
             report_figures.passes_figure(best, colors, passes, path, scene)
             figures.passes[scene] = path
     for sweep in find_sweeps(runs):
+        why = no_effect(sweep)
+        if why:
+            figures.no_effect.append((sweep, why))
+            continue
         name = f"sweep_{slug(sweep.technique)}_{slug(sweep.scene)}_{slug(sweep.key)}.svg"
         path = os.path.join(fig_dir, name)
+        basis = scene_basis(scenes[sweep.scene])
         baseline = None
         if sweep.technique != BASELINE_TECHNIQUE:
-            direct = [r for r in runs if r.scene == sweep.scene
-                      and r.technique == BASELINE_TECHNIQUE]
-            baseline = best_run(direct)
-        report_figures.sweep_figure(sweep, colors, path, baseline)
+            direct = [r for r in scenes[sweep.scene] if r.technique == BASELINE_TECHNIQUE]
+            baseline = best_run(direct, basis)
+        report_figures.sweep_figure(sweep, colors, path, basis, baseline)
         figures.sweeps.append((sweep, path))
     return figures
 
@@ -105,13 +119,12 @@ def build_report(dirs: list[str], out_dir: str) -> str:
     out_dir = os.path.abspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
     colors = technique_colors([r.technique for r in results.runs])
-    basis = ranking_basis(results.runs)
-    bases = [MATCHED] + ([ONE_BOUNCE] if has_one_bounce(results.runs) else []) + (
-        [basis] if basis is not MATCHED else [])
-    figures = write_figures(results, colors, bases, os.path.join(out_dir, "figures"))
-    fronts = {scene: pareto_fronts(rs, basis) for scene, rs in by_scene(results.runs).items()}
-    page = Page(out_dir=out_dir, results=results, colors=colors, figures=figures, basis=basis,
-                bases=bases, fronts=fronts,
+    figures = write_figures(results, colors, os.path.join(out_dir, "figures"))
+    scenes = by_scene(results.runs)
+    bases = {scene: scene_basis(rs) for scene, rs in scenes.items()}
+    page = Page(out_dir=out_dir, results=results, colors=colors, figures=figures, bases=bases,
+                fronts={s: pareto_fronts(rs, bases[s]) for s, rs in scenes.items()},
+                ties={s: pareto_ties(rs, bases[s]) for s, rs in scenes.items()},
                 docs_dir=REPO_DOCS if os.path.isdir(REPO_DOCS) else None,
                 generated=datetime.datetime.now(datetime.timezone.utc)
                 .strftime("%Y-%m-%dT%H:%M:%SZ"),

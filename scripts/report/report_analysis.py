@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import Callable, Optional
 
 from report_data import MetricView, Run, num, text
+from report_noise import front_ties
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
 TECHNIQUE_PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
@@ -85,19 +86,32 @@ def _none_last(value: Optional[float]) -> tuple[bool, float]:
     return (value is None, value if value is not None else 0.0)
 
 
-def best_key(run: Run) -> tuple:
-    """Ordering of 'best': lowest mean FLIP, then lowest relMSE, then fastest (None last)."""
-    return (_none_last(run.final.flip_mean), _none_last(run.final.rel_mse),
+def best_key(run: Run, basis: "Basis") -> tuple:
+    """Ordering of 'best': lowest mean FLIP of the basis, then its relMSE, then fastest (None
+    last)."""
+    return (_none_last(basis.flip(run)), _none_last(basis.rel_mse(run)),
             _none_last(run.frame_ms), run.key)
 
 
-def best_run(runs: list[Run]) -> Optional[Run]:
-    """The best ok run (best_key); a nonfinite one only if the technique has no ok run."""
+def best_run(runs: list[Run], basis: "Basis") -> Optional[Run]:
+    """The best ok run (best_key on the basis); a nonfinite one only if there is no ok run."""
     for status in ("ok", "nonfinite"):
         candidates = [r for r in runs if r.status == status]
         if candidates:
-            return min(candidates, key=best_key)
+            return min(candidates, key=lambda r: best_key(r, basis))
     return None
+
+
+def best_runs(runs: list[Run], basis: "Basis") -> list[Run]:
+    """The best run of each technique and reference group of the basis (one per technique on
+    the full basis: every run is compared with the same reference)."""
+    out = []
+    for tech_runs in by_technique(runs).values():
+        groups: dict[str, list[Run]] = {}
+        for run in tech_runs:
+            groups.setdefault(basis.group(run), []).append(run)
+        out += [b for b in (best_run(g, basis) for _, g in sorted(groups.items())) if b]
+    return out
 
 
 def by_scene(runs: list[Run]) -> dict[str, list[Run]]:
@@ -135,26 +149,34 @@ def pareto_front(runs: list[Run], error: Callable[[Run], Optional[float]]) -> li
 class Basis:
     """Which reference errors are measured against, for ranking runs against each other.
 
-    "matched": metrics.final, against the reference with the light paths the technique claims
-    (runs are only ranked against runs compared with the same reference); "full":
-    metrics.final_vs_full, against all the light, so every run of a scene is comparable.
+    "full": metrics.final_vs_full, against all the light paths, so every run of a scene is
+    comparable: the headline basis. "matched": metrics.final, against the reference with the
+    light paths the technique claims (the error of what it claims; runs are only ranked against
+    runs compared with the same reference). "one_bounce": metrics.final_vs_bounces.1.
     """
 
     name: str
-    caption: str
+    caption: str  # "vs. the full reference (all light paths)"
+    reference: str  # "full reference", for labels: "HDR-FLIP vs full reference"
     flip: Callable[[Run], Optional[float]]
     flip_sigma: Callable[[Run], Optional[float]]
     rel_mse: Callable[[Run], Optional[float]]
     rel_mse_sigma: Callable[[Run], Optional[float]]
     group: Callable[[Run], str]
 
+    def label(self, metric: str = "HDR-FLIP", group: str = "") -> str:
+        """'HDR-FLIP vs full reference', 'relMSE vs bounce-matched reference (emission+direct)'."""
+        detail = f" ({group})" if group and self.name == "matched" else ""
+        return f"{metric} vs {self.reference}{detail}"
 
-MATCHED = Basis("matched", "vs. the bounce-matched reference", lambda r: r.final.flip_mean,
+
+MATCHED = Basis("matched", "vs. the bounce-matched reference (the light paths the technique "
+                "claims)", "bounce-matched reference", lambda r: r.final.flip_mean,
                 lambda r: r.final.flip_sigma, lambda r: r.final.rel_mse,
                 lambda r: r.final.rel_mse_sigma, lambda r: r.reference_label())
-FULL = Basis("full", "vs. the full reference (all light paths)", lambda r: r.vs_full.flip_mean,
-             lambda r: r.vs_full.flip_sigma, lambda r: r.vs_full.rel_mse,
-             lambda r: r.vs_full.rel_mse_sigma, lambda r: "full")
+FULL = Basis("full", "vs. the full reference (all light paths)", "full reference",
+             lambda r: r.vs_full.flip_mean, lambda r: r.vs_full.flip_sigma,
+             lambda r: r.vs_full.rel_mse, lambda r: r.vs_full.rel_mse_sigma, lambda r: "full")
 
 
 def _one_bounce(run: Run) -> MetricView:
@@ -162,9 +184,9 @@ def _one_bounce(run: Run) -> MetricView:
 
 
 ONE_BOUNCE = Basis("one_bounce", "vs. the one-bounce reference (emission + direct + bounce 1)",
-                   lambda r: _one_bounce(r).flip_mean, lambda r: _one_bounce(r).flip_sigma,
-                   lambda r: _one_bounce(r).rel_mse, lambda r: _one_bounce(r).rel_mse_sigma,
-                   lambda r: "emission+direct+bounce1")
+                   "one-bounce reference", lambda r: _one_bounce(r).flip_mean,
+                   lambda r: _one_bounce(r).flip_sigma, lambda r: _one_bounce(r).rel_mse,
+                   lambda r: _one_bounce(r).rel_mse_sigma, lambda r: "emission+direct+bounce1")
 
 
 def has_one_bounce(runs: list[Run]) -> bool:
@@ -188,8 +210,9 @@ def baseline_value(baseline: Optional[Run], bounces: Optional[int],
     return metric(view) if view is not None else None
 
 
-def ranking_basis(runs: list[Run]) -> Basis:
-    """FULL when any run has errors against the full reference, else MATCHED."""
+def scene_basis(runs: list[Run]) -> Basis:
+    """The one basis every headline number and ranking of a scene uses: FULL when any measured
+    run of the scene has errors against the full reference, else MATCHED (older results)."""
     return FULL if any(FULL.flip(r) is not None for r in runs if r.measured) else MATCHED
 
 
@@ -215,6 +238,20 @@ def pareto_fronts(runs: list[Run], basis: Basis,
     error = error or basis.flip
     return {label: pareto_front(members, error)
             for label, members in comparable_groups(runs, basis, error).items()}
+
+
+def pareto_ties(runs: list[Run], basis: Basis,
+                error: Optional[Callable[[Run], Optional[float]]] = None,
+                sigma: Optional[Callable[[Run], Optional[float]]] = None
+                ) -> dict[str, dict[int, Run]]:
+    """Per comparable group: the runs off its front that are inseparable from a front run
+    (frame-time IQRs and error bars both overlap), id(run) -> that front run (report_noise)."""
+    error = error or basis.flip
+    sigma = sigma or basis.flip_sigma
+    out = {}
+    for label, members in comparable_groups(runs, basis, error).items():
+        out[label] = front_ties(members, pareto_front(members, error), error, sigma)
+    return out
 
 
 def time_budgets(times: list[float]) -> list[float]:

@@ -36,6 +36,16 @@ table.meta td:first-child { color: var(--muted); white-space: nowrap; }
 .b-best { background: #0b5cad; color: #fff; }
 .b-noise { background: #e3f3e6; color: #17602a; }
 .b-front { background: #fff3c4; color: #6b5200; }
+.b-tie { background: #e8e8f4; color: #33336b; border: 1px dashed #8888aa; }
+.basis { font-weight: 600; }
+.card-nums .headline { font-size: 13px; }
+.card-nums .second { color: #333; }
+.card-links { font-size: 12px; margin-top: 2px; }
+.device-note { display: inline-block; max-width: 980px; background: #fff4e5;
+               border-left: 4px solid #e69f00; padding: 2px 8px; }
+ul.trend { margin: 2px 0 0; padding-left: 18px; font-size: 12px; }
+li.no-effect { margin: 3px 0; }
+td.params details summary { font-size: 11px; }
 .exposure-bar { display: flex; gap: 10px; align-items: center; flex-wrap: wrap; margin: 6px 0 10px;
                 padding: 6px 10px; background: var(--bg2); border-radius: 4px; font-size: 13px; }
 .exposure-bar input[type=range] { width: 220px; }
@@ -60,6 +70,16 @@ details { margin: 8px 0; }
 details summary { cursor: pointer; color: var(--accent); font-size: 13px; }
 details .cards { margin-top: 8px; }
 .table-wrap { overflow-x: auto; max-width: 100%; border: 1px solid var(--line); }
+#run-table th { white-space: normal; min-width: 56px; max-width: 120px; vertical-align: bottom; }
+#run-table th:first-child, #run-table td:first-child { position: sticky; left: 0; z-index: 2;
+  background: #fff; box-shadow: 1px 0 0 #bbb; white-space: nowrap; }
+#run-table th:first-child { z-index: 3; background: #f0f0f0; }
+#run-table tr:nth-child(even) td:first-child { background: #fafafa; }
+#run-table tr.noise td:first-child { background: #eef8f0; }
+#run-table tr.invalid td:first-child { background: #fdecea; }
+details.more-params { margin: 0; display: inline; }
+details.more-params summary { display: inline; font-size: 11px; }
+details.more-params[open] { display: block; }
 table.data { border-collapse: collapse; font-size: 12px; font-variant-numeric: tabular-nums; }
 table.data th, table.data td { padding: 3px 7px; border-bottom: 1px solid #eee;
                                text-align: left; vertical-align: top; }
@@ -73,7 +93,7 @@ table.sortable th { cursor: pointer; user-select: none; }
 table.sortable th::after { content: " \\2195"; color: #aaa; font-weight: 400; }
 table.sortable th[aria-sort=ascending]::after { content: " \\25B2"; color: #333; }
 table.sortable th[aria-sort=descending]::after { content: " \\25BC"; color: #333; }
-td.params { min-width: 170px; max-width: 280px; font-size: 11px; }
+td.params { min-width: 150px; max-width: 240px; font-size: 11px; }
 td.params b { font-weight: 600; }
 td.passes { font-size: 11px; min-width: 240px; max-width: 460px; }
 td.passes .pass { white-space: nowrap; }

@@ -8,12 +8,12 @@ import urllib.parse
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
-from report_analysis import Basis, Sweep, ordered_unique, param_value, slug
+from report_analysis import MATCHED, Basis, Sweep, ordered_unique, param_value, slug
 from report_data import Results, Run, dig, num, text
 
 DASH = "—"
-CARD_IMAGE_WIDTH = 200  # CSS px of each final / FLIP image in the scene cards
-REF_IMAGE_WIDTH = 200
+CARD_IMAGE_WIDTH = 150  # CSS px of each image in the scene cards (four side by side)
+REF_IMAGE_WIDTH = 150
 MIB = 1024.0 * 1024.0
 
 
@@ -24,6 +24,7 @@ class Figures:
     pareto: dict[str, str] = field(default_factory=dict)  # scene -> svg
     passes: dict[str, str] = field(default_factory=dict)  # scene -> svg
     sweeps: list[tuple[Sweep, str]] = field(default_factory=list)
+    no_effect: list[tuple[Sweep, str]] = field(default_factory=list)  # sweep, why (no figure)
 
 
 @dataclass
@@ -34,12 +35,26 @@ class Page:
     results: Results
     colors: dict[str, str]
     figures: Figures
-    basis: Basis  # the errors runs are ranked by (fronts, equal-time tables)
-    bases: list[Basis]  # the rows of the error-vs-time figures
+    bases: dict[str, Basis]  # scene -> the one basis of its headline numbers and rankings
     fronts: dict[str, dict[str, list[Run]]]  # scene -> comparable group -> front (mean FLIP)
+    ties: dict[str, dict[str, dict[int, Run]]]  # scene -> group -> id(run) -> front run it ties
     docs_dir: Optional[str]
     generated: str
     tool_versions: str
+
+    def basis(self, scene: str) -> Basis:
+        return self.bases.get(scene) or MATCHED
+
+    def on_front(self, run: Run) -> bool:
+        return any(run is r for front in self.fronts.get(run.scene, {}).values()
+                   for r in front)
+
+    def tie_of(self, run: Run) -> Optional[Run]:
+        """The front run this run ties with (inseparable within IQR and error bars)."""
+        for ties in self.ties.get(run.scene, {}).values():
+            if id(run) in ties:
+                return ties[id(run)]
+        return None
 
 
 # ---------------------------------------------------------------------------------------------
@@ -127,13 +142,28 @@ def status_badge(status: str) -> str:
     return f'<span class="badge st-{esc(status)}">{esc(status)}</span>'
 
 
+SHORT_PARAMS = 3  # parameter lists up to this long are shown whole
+
+
 def params_html(run: Run) -> str:
-    """Swept parameters in bold, then the others."""
-    parts = []
-    for key in ordered_unique(list(run.swept) + list(run.params)):
-        item = f"{esc(key)}={esc(param_value(run, key))}"
-        parts.append(f"<b>{item}</b>" if key in run.swept else item)
-    return ", ".join(parts) if parts else f'<span class="muted">{DASH}</span>'
+    """Swept parameters in bold; the others inline when the list is short, else one click away
+    in a <details> ("+ N more")."""
+    keys = ordered_unique(list(run.swept) + list(run.params))
+    if not keys:
+        return f'<span class="muted">{DASH}</span>'
+
+    def item(key: str) -> str:
+        shown = f"{esc(key)}={esc(param_value(run, key))}"
+        return f"<b>{shown}</b>" if key in run.swept else shown
+
+    swept = [k for k in keys if k in run.swept]
+    rest = [k for k in keys if k not in run.swept]
+    if len(keys) <= SHORT_PARAMS:
+        return ", ".join(item(k) for k in keys)
+    head = ", ".join(item(k) for k in swept)
+    more = "more" if swept else "parameters"
+    return (f'{head} <details class="more-params"><summary>+ {len(rest)} {more}</summary>'
+            + ", ".join(item(k) for k in rest) + "</details>")
 
 
 def doc_link(page: Page, name: str) -> str:

@@ -135,6 +135,7 @@ class Run:
     final: MetricView  # against the bounce-matched reference (metrics.final)
     vs_full: MetricView  # against the full reference (metrics.final_vs_full)
     indirect: MetricView
+    direct: MetricView  # direct-light layer vs. the reference's emission+direct (metrics.direct)
     regions: dict  # region name -> MetricView of its final layer
     energy_ratio: Optional[float]
     frame_ms: Optional[float]  # median frame time (GPU, else CPU)
@@ -148,6 +149,8 @@ class Run:
     # many indirect bounces, whatever the technique claims (puts `direct` next to 1-bounce GI)
     vs_bounces: dict = field(default_factory=dict)
     claimed_bounces: Optional[int] = None  # technique.indirect_bounces (-1 = all)
+    device_type: str = ""  # device.type: "cpu" (lavapipe), "discrete", "integrated", ...
+    device_driver: str = ""  # device.driver
 
     @property
     def measured(self) -> bool:
@@ -188,11 +191,16 @@ class Run:
             return None
         return os.path.normpath(os.path.join(self.folder, rel))
 
-    def reference_png(self) -> Optional[str]:
-        rel = dig(self.data, "reference", "final_png")
+    def reference_path(self, name: str) -> Optional[str]:
+        """Absolute path of reference.<name> (final_png, full_png, indirect_png, ...; relative to
+        the run folder), None if not given."""
+        rel = dig(self.data, "reference", name)
         if not isinstance(rel, str) or not rel:
             return None
         return os.path.normpath(os.path.join(self.folder, rel))
+
+    def reference_png(self) -> Optional[str]:
+        return self.reference_path("final_png")
 
     def reference_label(self) -> str:
         return text(dig(self.data, "reference", "matched"))
@@ -257,6 +265,7 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
         final=MetricView.parse(dig(data, "metrics", "final")),
         vs_full=MetricView.parse(dig(data, "metrics", "final_vs_full")),
         indirect=MetricView.parse(dig(data, "metrics", "indirect")),
+        direct=MetricView.parse(dig(data, "metrics", "direct")),
         regions=regions,
         energy_ratio=num(dig(data, "metrics", "energy_ratio")),
         frame_ms=num(frame.get("median")),
@@ -271,6 +280,8 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
         claimed_bounces=(int(num(dig(data, "technique", "indirect_bounces")))
                          if num(dig(data, "technique", "indirect_bounces")) is not None
                          else None),
+        device_type=text(dig(data, "device", "type")),
+        device_driver=text(dig(data, "device", "driver")),
     )
 
 

@@ -5,6 +5,8 @@ caller (report_analysis.technique_colors) so that a technique has one colour eve
 """
 from __future__ import annotations
 
+import textwrap
+from dataclasses import dataclass
 from typing import Callable, Optional
 
 import matplotlib
@@ -13,10 +15,11 @@ matplotlib.use("svg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from report_analysis import (GREYS, Basis, Sweep, baseline_value, param_value,  # noqa: E402
-                             pareto_fronts, shade, sweep_x)
+from report_analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E402
+                             param_value, pareto_fronts, pareto_ties, shade, sweep_x)
+from report_device import device_label, time_label  # noqa: E402
 from report_data import Run, text  # noqa: E402
 
 STYLE = {
@@ -37,6 +40,7 @@ STYLE = {
     "figure.dpi": 100,
 }
 FRONT_STYLES = ("--", ":", "-.", (0, (6, 2, 1, 2, 1, 2)), (0, (1, 1)), (0, (8, 3)))
+IQR_GID = "iqr-bars"  # SVG id prefix of the frame-time IQR bars (the report's test looks for it)
 LOG_SPAN = 10.0  # use a log axis when the largest positive value is > LOG_SPAN x the smallest
 
 Metric = Callable[[Run], Optional[float]]
@@ -64,17 +68,8 @@ def _log_axis(axis: matplotlib.axis.Axis) -> None:
     axis.set_minor_formatter(NullFormatter())
 
 
-def _time_label(runs: list[Run]) -> str:
-    sources = {r.frame_source for r in runs if r.frame_source}
-    if sources == {"cpu"}:
-        return "median frame time [ms] (CPU)"
-    if "cpu" in sources:
-        return "median frame time [ms] (GPU; CPU where no GPU timings)"
-    return "median frame time [ms] (GPU)"
-
-
 def _xerr(runs: list[Run]) -> Optional[list[list[float]]]:
-    """Asymmetric x bars from the frame-time quartiles (0 where unknown)."""
+    """Asymmetric bars from the frame-time quartiles (0 where unknown)."""
     lo = [max(0.0, r.frame_ms - r.frame_q1) if r.frame_q1 is not None else 0.0 for r in runs]
     hi = [max(0.0, r.frame_q3 - r.frame_ms) if r.frame_q3 is not None else 0.0 for r in runs]
     return [lo, hi] if any(lo) or any(hi) else None
@@ -85,12 +80,19 @@ def _yerr(runs: list[Run], sigma: Metric) -> Optional[list[float]]:
     return values if any(values) else None
 
 
+def _title(ax: plt.Axes, title: str, width: int = 52) -> None:
+    """A panel title wrapped to the panel's width (constrained layout keeps them apart)."""
+    ax.set_title(textwrap.fill(title, width), fontsize=9)
+
+
 def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis: Basis,
                    error: Metric, sigma: Metric, ylabel: str) -> None:
     """Error against frame time, one colour per technique, the Pareto front of each group of
-    comparable runs as a step line (runs on it ringed)."""
+    comparable runs as a step line (runs on it ringed; runs tied with it within the noise in a
+    dashed grey ring)."""
     plotted = [r for r in runs if r.measured and r.frame_ms is not None and error(r) is not None]
     ax.set_ylabel(ylabel)
+    ax.set_xlabel(time_label([r for r in runs if r.measured], "median frame time"))
     if not plotted:
         ax.text(0.5, 0.5, "no run has this metric", ha="center", va="center",
                 transform=ax.transAxes, color="#777777")
@@ -100,61 +102,80 @@ def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis:
             group = [r for r in plotted if r.technique == tech and r.status == status]
             if not group:
                 continue
-            ax.errorbar([r.frame_ms for r in group], [error(r) for r in group],
-                        xerr=_xerr(group), yerr=_yerr(group, sigma), fmt=marker, ms=size,
-                        color=colors[tech], mec="black" if status == "nonfinite" else colors[tech],
-                        mew=0.8, elinewidth=0.8, capsize=0, alpha=0.9, zorder=3)
+            xerr = _xerr(group)
+            bars = ax.errorbar([r.frame_ms for r in group], [error(r) for r in group],
+                               xerr=xerr, yerr=_yerr(group, sigma), fmt=marker, ms=size,
+                               color=colors[tech],
+                               mec="black" if status == "nonfinite" else colors[tech],
+                               mew=0.8, elinewidth=0.8, capsize=0, alpha=0.9, zorder=3)
+            if xerr is not None:
+                bars.lines[2][0].set_gid(IQR_GID)  # the frame-time IQR bars (x comes first)
     right = max(r.frame_ms for r in plotted)
-    styles = ("-",) if basis.name == "full" else FRONT_STYLES
+    styles = FRONT_STYLES if basis.name == "matched" else ("-",)
     for style, front in zip(styles, pareto_fronts(runs, basis, error).values()):
         xs = [r.frame_ms for r in front] + [right]
         ys = [error(r) for r in front] + [error(front[-1])]
         ax.step(xs, ys, where="post", color="black", lw=1.0, ls=style, zorder=2)
         ax.plot(xs[:-1], ys[:-1], "o", ms=9, mfc="none", mec="black", mew=0.8, zorder=4)
+    tied = [r for ties in pareto_ties(runs, basis, error, sigma).values()
+            for r in plotted if id(r) in ties]
+    if tied:
+        ax.plot([r.frame_ms for r in tied], [error(r) for r in tied], "o", ms=10, mfc="none",
+                mec="#777777", mew=0.9, ls="none", zorder=4, dashes=(2, 1))
     if _wants_log([r.frame_ms for r in plotted]):
         ax.set_xscale("log")
         _log_axis(ax.xaxis)
     if _wants_log([error(r) for r in plotted]):
         ax.set_yscale("log")
         _log_axis(ax.yaxis)
-    ax.set_xlabel(_time_label(plotted))
 
 
 def _pareto_legend(fig: plt.Figure, runs: list[Run], colors: dict[str, str],
                    bases: list[Basis]) -> None:
     techs = sorted({r.technique for r in runs if r.measured})
     handles = [Line2D([], [], marker="o", ls="none", color=colors[t], label=t) for t in techs]
-    groups = list(pareto_fronts(runs, bases[0]))
-    for style, label in zip(FRONT_STYLES, groups):
-        name = f"Pareto front (reference {label})" if len(groups) > 1 else \
-            "Pareto front" + (" (matched reference)" if len(bases) > 1 else "")
-        handles.append(Line2D([], [], color="black", ls=style, marker="o", mfc="none",
-                              label=name))
-    if any(b.name == "full" for b in bases):
+    single = [b for b in bases if b.name != "matched"]
+    if single:
         handles.append(Line2D([], [], color="black", ls="-", marker="o", mfc="none",
-                              label="Pareto front (full reference)"))
+                              label="Pareto front (" + " / ".join(b.reference for b in single)
+                              + ")"))
+    if any(b.name == "matched" for b in bases):
+        groups = list(pareto_fronts(runs, MATCHED))
+        for style, label in zip(FRONT_STYLES, groups):
+            handles.append(Line2D([], [], color="black", ls=style, marker="o", mfc="none",
+                                  label=f"Pareto front, matched reference {label}"))
+    handles.append(Line2D([], [], marker="o", ls="none", ms=10, mfc="none", mec="#777777",
+                          label="tie with the front (IQR and error bars overlap)"))
     if any(r.status == "nonfinite" for r in runs):
         handles.append(Line2D([], [], marker="X", ls="none", color="#999999", mec="black",
                               label="nonfinite output"))
-    fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 6),
+    fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 4),
                bbox_to_anchor=(0.5, 0.0), frameon=False)
+
+
+def _row_title(basis: Basis, runs: list[Run], metric: str) -> str:
+    if basis.name != "matched":
+        return basis.label(metric)
+    labels = sorted({r.reference_label() for r in runs if r.measured and r.reference_label()})
+    group = labels[0] if len(labels) == 1 else "each run's own"
+    return basis.label(metric, group) + " (the light paths each technique claims)"
 
 
 def pareto_figure(runs: list[Run], colors: dict[str, str], bases: list[Basis], path: str,
                   scene: str) -> None:
-    """Mean FLIP and relMSE against median frame time for one scene: one row of two panels per
-    basis (errors against the matched reference, and against the full one when measured)."""
-    fig, axes = plt.subplots(len(bases), 2, figsize=(10.0, 3.7 * len(bases)), squeeze=False,
-                             gridspec_kw={"wspace": 0.28, "hspace": 0.42})
+    """Mean HDR-FLIP and relMSE against median frame time for one scene: one row of two panels
+    per basis, the headline basis (the full reference) on top."""
+    fig, axes = plt.subplots(len(bases), 2, figsize=(10.0, 3.8 * len(bases)), squeeze=False,
+                             gridspec_kw={"wspace": 0.25, "hspace": 0.62})
     for row, basis in zip(axes, bases):
         _scatter_panel(row[0], runs, colors, basis, basis.flip, basis.flip_sigma,
-                       "mean FLIP (HDR-FLIP) ↓")
+                       "mean HDR-FLIP ↓")
         _scatter_panel(row[1], runs, colors, basis, basis.rel_mse, basis.rel_mse_sigma,
                        "relMSE ↓")
-        row[0].set_title(f"mean FLIP {basis.caption}", fontsize=9)
-        row[1].set_title(f"relMSE {basis.caption}", fontsize=9)
-    fig.suptitle(f"{scene}: error against frame time", fontsize=10,
-                 y=0.96 if len(bases) == 1 else 0.93)
+        _title(row[0], _row_title(basis, runs, "HDR-FLIP"))
+        _title(row[1], _row_title(basis, runs, "relMSE"))
+    fig.suptitle(f"{scene}: error against frame time (top row: the ranking basis)", fontsize=10,
+                 y=0.94 if len(bases) == 1 else 0.93)
     _pareto_legend(fig, runs, colors, bases)
     _save(fig, path)
 
@@ -168,29 +189,40 @@ def _sweep_positions(sweep: Sweep) -> tuple[dict[str, float], list[str]]:
     return {v: float(i) for i, v in enumerate(labels)}, labels
 
 
-def _sweep_panel(ax: plt.Axes, sweep: Sweep, color: str, value: Metric, sigma: Metric,
-                 positions: dict[str, float], ylabel: str) -> None:
+def _time_bars(runs: list[Run]) -> Optional[list[list[float]]]:
+    return _xerr(runs)
+
+
+def _sweep_panel(ax: plt.Axes, sweep: Sweep, color: str, panel: "SweepPanel",
+                 positions: dict[str, float]) -> None:
     n = len(sweep.series)
     drawn: list[float] = []
     for i, (others, members) in enumerate(sweep.series.items()):
         tone = shade(color, i, n)
         label = ", ".join(f"{k}={v}" for k, v in zip(sweep.other_keys, others)) or None
-        ok = [r for r in members if r.status == "ok" and value(r) is not None]
+        ok = [r for r in members if r.status == "ok" and panel.value(r) is not None]
         xs = [positions[text(param_value(r, sweep.key))] for r in ok]
-        ys = [value(r) for r in ok]
+        ys = [panel.value(r) for r in ok]
         drawn += ys
-        ax.errorbar(xs, ys, yerr=_yerr(ok, sigma), fmt="-o", ms=4, lw=1.3, color=tone,
-                    elinewidth=0.8, capsize=2, label=label)
-        bad = [r for r in members if r.status == "nonfinite" and value(r) is not None]
+        bars = _time_bars(ok) if panel.is_time else _yerr(ok, panel.sigma)
+        drawn_bars = ax.errorbar(xs, ys, yerr=bars, fmt="-o", ms=4, lw=1.3, color=tone,
+                                 elinewidth=0.9, capsize=3, label=label)
+        if panel.is_time and bars is not None:
+            drawn_bars.lines[2][0].set_gid(IQR_GID)
+        bad = [r for r in members if r.status == "nonfinite" and panel.value(r) is not None]
         if bad:
-            drawn += [value(r) for r in bad]
+            drawn += [panel.value(r) for r in bad]
             ax.plot([positions[text(param_value(r, sweep.key))] for r in bad],
-                    [value(r) for r in bad], "X", ms=8, color=tone, mec="black", mew=0.8)
+                    [panel.value(r) for r in bad], "X", ms=8, color=tone, mec="black", mew=0.8)
+    if not drawn:
+        ax.text(0.5, 0.5, "no run has this metric", ha="center", va="center",
+                transform=ax.transAxes, color="#777777")
     if _wants_log(drawn):
         ax.set_yscale("log")
         _log_axis(ax.yaxis)
-    ax.set_ylabel(ylabel)
+    ax.set_ylabel(panel.ylabel)
     ax.set_xlabel(sweep.key)
+    _title(ax, panel.title, 60)
 
 
 def _sweep_bounces(sweep: Sweep) -> Optional[int]:
@@ -199,46 +231,94 @@ def _sweep_bounces(sweep: Sweep) -> Optional[int]:
     return claimed.pop() if len(claimed) == 1 else None
 
 
-def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str,
+@dataclass
+class SweepPanel:
+    title: str
+    ylabel: str
+    value: Metric
+    sigma: Metric
+    baseline: Optional[float] = None  # the direct baseline against the same reference
+    is_time: bool = False
+
+
+def _sweep_panels(sweep: Sweep, basis: Basis, baseline: Optional[Run]) -> list[SweepPanel]:
+    """Headline error (the scene's basis), the bounce-matched view, relMSE, frame time ± IQR."""
+    runs = [r for members in sweep.series.values() for r in members]
+    bounces = _sweep_bounces(sweep)
+    panels = [SweepPanel(basis.label("HDR-FLIP"), "mean HDR-FLIP ↓", basis.flip,
+                         basis.flip_sigma)]
+    if basis.name != "matched":
+        panels[0].baseline = basis.flip(baseline) if baseline is not None else None
+        panels.append(SweepPanel(_row_title(MATCHED, runs, "HDR-FLIP"), "mean HDR-FLIP ↓",
+                                 MATCHED.flip, MATCHED.flip_sigma,
+                                 baseline_value(baseline, bounces, lambda m: m.flip_mean)))
+        panels.append(SweepPanel(basis.label("relMSE"), "relMSE ↓", basis.rel_mse,
+                                 basis.rel_mse_sigma,
+                                 basis.rel_mse(baseline) if baseline is not None else None))
+    else:
+        panels[0].baseline = baseline_value(baseline, bounces, lambda m: m.flip_mean)
+        panels.append(SweepPanel(basis.label("relMSE"), "relMSE ↓", basis.rel_mse,
+                                 basis.rel_mse_sigma,
+                                 baseline_value(baseline, bounces, lambda m: m.rel_mse)))
+    measured = [r for r in runs if r.measured]
+    panels.append(SweepPanel("median frame time ± IQR", time_label(measured, "median frame time"),
+                             lambda r: r.frame_ms, lambda r: None,
+                             baseline.frame_ms if baseline is not None else None, True))
+    return panels
+
+
+def _integer_values(values: list[float]) -> bool:
+    return bool(values) and all(float(v).is_integer() for v in values)
+
+
+def _sweep_ticks(ax: plt.Axes, positions: dict[str, float], categories: list[str]) -> None:
+    """Categories by name; numbers at their values when few (integers as integers), a log
+    axis (base 2) when they span more than 10x."""
+    ticks = sorted(set(positions.values()))
+    if categories:
+        ax.set_xticks(range(len(categories)), categories)
+        return
+    if _wants_log(ticks):
+        ax.set_xscale("log", base=2)
+        ax.minorticks_off()
+    if len(ticks) <= 12:
+        ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
+    elif _integer_values(ticks):
+        ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+
+
+def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str, basis: Basis,
                  baseline: Optional[Run] = None) -> None:
-    """Mean FLIP, relMSE and frame time against the swept parameter (three panels); with a
-    baseline run (`direct`), its error against the same reference and its frame time as a
-    dashed line."""
+    """The swept parameter against the scene's headline error (basis), the bounce-matched error,
+    relMSE and the frame time with its IQR as bars; a baseline run (`direct`) as a dashed line
+    measured against the same reference."""
     positions, categories = _sweep_positions(sweep)
     color = colors[sweep.technique]
-    fig, axes = plt.subplots(1, 3, figsize=(11.0, 3.3), gridspec_kw={"wspace": 0.32})
-    bounces = _sweep_bounces(sweep)
-    panels = (
-        (lambda r: r.final.flip_mean, lambda r: r.final.flip_sigma, "mean FLIP (HDR-FLIP) ↓",
-         baseline_value(baseline, bounces, lambda m: m.flip_mean)),
-        (lambda r: r.final.rel_mse, lambda r: r.final.rel_mse_sigma, "relMSE ↓",
-         baseline_value(baseline, bounces, lambda m: m.rel_mse)),
-        (lambda r: r.frame_ms, lambda r: None, "median frame time [ms]",
-         baseline.frame_ms if baseline is not None else None),
-    )
-    for ax, (value, sigma, label, base) in zip(axes, panels):
-        _sweep_panel(ax, sweep, color, value, sigma, positions, label)
-        if base is not None and baseline is not None:
-            ax.axhline(base, ls="--", lw=1.0, color=colors.get(baseline.technique, "#777777"),
+    panels = _sweep_panels(sweep, basis, baseline)
+    rows = (len(panels) + 1) // 2
+    fig, axes = plt.subplots(rows, 2, figsize=(10.0, 3.4 * rows), squeeze=False,
+                             gridspec_kw={"wspace": 0.25, "hspace": 0.62})
+    flat = list(axes.flat)
+    for ax, panel in zip(flat, panels):
+        _sweep_panel(ax, sweep, color, panel, positions)
+        if panel.baseline is not None and baseline is not None:
+            ax.axhline(panel.baseline, ls="--", lw=1.0,
+                       color=colors.get(baseline.technique, "#777777"),
                        label=f"{baseline.technique} (same reference)")
-        if categories:
-            ax.set_xticks(range(len(categories)), categories)
-        elif _wants_log(list(positions.values())):
-            ax.set_xscale("log", base=2)
-            ticks = sorted(set(positions.values()))
-            ax.set_xticks(ticks, [f"{t:g}" for t in ticks])
-            ax.minorticks_off()
-    handles, labels = axes[0].get_legend_handles_labels()
+        _sweep_ticks(ax, positions, categories)
+    for ax in flat[len(panels):]:
+        ax.set_visible(False)
+    handles, _ = flat[0].get_legend_handles_labels()
     extra = []
     if any(r.status == "nonfinite" for m in sweep.series.values() for r in m):
         extra = [Line2D([], [], marker="X", ls="none", color="#999999", mec="black",
                         label="nonfinite output")]
     if len(handles) > 1 or extra or baseline is not None:
         fig.legend(handles=handles + extra, loc="upper center",
-                   ncol=min(len(handles) + len(extra), 6), bbox_to_anchor=(0.5, -0.04),
+                   ncol=min(len(handles) + len(extra), 4), bbox_to_anchor=(0.5, 0.0),
                    frameon=False)
     fig.suptitle(f"{sweep.technique} on {sweep.scene}: sweep of {sweep.key}", fontsize=10,
-                 color=color, y=1.0)
+                 color=color, y=0.99 if rows > 1 else 1.04)
     _save(fig, path)
 
 
@@ -283,12 +363,12 @@ def passes_figure(best: list[Run], tech_colors: dict[str, str], pass_colors: dic
 
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.9), gridspec_kw={"wspace": 0.75})
     _stacked_bars(axes[0], best, frame, lambda run, name: pass_colors[name])
-    axes[0].set_ylabel("median GPU time per frame [ms]")
-    axes[0].set_title("per-frame GPU time by pass")
+    axes[0].set_ylabel(time_label(best, "median time per frame"))
+    axes[0].set_title(f"per-frame time by pass ({device_label(best)})")
     used = list(dict.fromkeys(n for stack in frame for n, _ in stack))
     _legend(axes[0], [(n, pass_colors[n]) for n in reversed(used)])
     _stacked_bars(axes[1], best, setup, setup_color)
-    axes[1].set_ylabel("set-up time [ms] (CPU wall clock)")
+    axes[1].set_ylabel(time_label(best, "set-up time (wall clock)"))
     axes[1].set_title("one-time set-up by stage")
     entries = [("technique (its colour)", "white")] if any(
         n == "technique" for stack in setup for n, _ in stack) else []

@@ -6,12 +6,17 @@ the shared helpers in report_common.py.
 """
 from __future__ import annotations
 
-from report_analysis import best_run, by_scene, by_technique, params_text
+import os
+from typing import Optional
+
+from report_analysis import MATCHED, Sweep, best_runs, by_scene, param_value, params_text
 from report_assets import BODY_JS, CSS, HEAD_JS, MAGMA_STOPS
 from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, esc,
                            fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
                            rel_url, scene_anchor, status_badge, swatch, with_bar)
 from report_data import Run, dig, num, text
+from report_device import device_label, time_label
+from report_noise import change_words, tied_best, time_change_words
 from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
                            invalid_banner_html, run_table_html, skipped_html, unreadable_html)
 
@@ -20,58 +25,135 @@ from report_tables import (equal_html, experiment_name, failures_html, footer_ht
 # Section 2: images per scene
 # ---------------------------------------------------------------------------------------------
 
-def _card(run: Run, page: Page, best: bool, lazy: bool) -> str:
+def _metric_line(label: str, view_flip: Optional[float], sigma: Optional[float],
+                 rel_mse: Optional[float], css: str) -> str:
+    return (f'<div class="{css}"><span class="basis">{esc(label)}</span> '
+            f'<b class="v">{with_bar(fmt_flip(view_flip), sigma, fmt_flip)}</b>'
+            f' · relMSE {fmt_sig(rel_mse)}</div>')
+
+
+def _card_numbers(run: Run, page: Page, ties: list[Run]) -> str:
+    """The headline number (the scene's basis), then the bounce-matched view and the direct-light
+    layer, each with its label."""
+    basis = page.basis(run.scene)
+    group = basis.group(run) if basis.name == "matched" else ""
+    parts = [_metric_line(basis.label("HDR-FLIP", group), basis.flip(run), basis.flip_sigma(run),
+                          basis.rel_mse(run), "headline")]
+    parts.append(f'<div class="time">{fmt_ms(run.frame_ms)} '
+                 f'<span class="pm">± {fmt_ms(run.frame_iqr)}</span> ms '
+                 f'<span class="muted">{esc(time_label([run], "frame time", ""))}</span></div>'
+                 if run.frame_iqr is not None else
+                 f'<div class="time">{fmt_ms(run.frame_ms)} ms <span class="muted">'
+                 f'{esc(time_label([run], "frame time", ""))}</span></div>')
+    if basis.name != "matched" and run.final.flip_mean is not None:
+        parts.append(_metric_line(MATCHED.label("HDR-FLIP", run.reference_label()),
+                                  run.final.flip_mean, run.final.flip_sigma, run.final.rel_mse,
+                                  "second") + '<div class="muted">the error of the light paths '
+                     'the technique claims</div>')
+    if run.direct.flip_mean is not None:
+        parts.append(_metric_line("direct light: HDR-FLIP vs reference emission+direct",
+                                  run.direct.flip_mean, run.direct.flip_sigma,
+                                  run.direct.rel_mse, "second"))
+    if ties:
+        parts.append(f'<div class="muted">tied within the error bars with {len(ties)} other '
+                     f'run{"s" if len(ties) != 1 else ""} of {esc(run.technique)}</div>')
+    bad = nonfinite_count(run)
+    if bad:
+        parts.append(f'<div><b>{int(bad)} NaN/Inf px</b> <span class="muted">(magenta)</span>'
+                     '</div>')
+    return "".join(parts)
+
+
+def _exr_link(run: Run, page: Page) -> str:
+    path = run.output_path("exr")
+    if not path:
+        return ""
+    if not os.path.isfile(path):
+        return f'<span class="muted">EXR missing: {esc(os.path.relpath(path, page.out_dir))}</span>'
+    return f'<a class="exr" href="{rel_url(path, page.out_dir)}">output.exr (linear)</a>'
+
+
+def _card(run: Run, page: Page, best: bool, lazy: bool, ties: list[Run]) -> str:
     color = page.colors.get(run.technique, "#888")
-    badges = '<span class="badge b-best">best</span>' if best else ""
+    badges = ""
+    if best:
+        badges = ('<span class="badge b-best">best</span>' if not ties else
+                  '<span class="badge b-tie" title="another run is within the error bars">'
+                  'best (tie)</span>')
     if run.status != "ok":
         badges += status_badge(run.status)
     if run.final.within_reference_noise:
         badges += '<span class="badge b-noise">within ref. noise</span>'
-    final = img_html(run.output_path("final_png"), page, f"{run.technique} final",
-                     CARD_IMAGE_WIDTH, "expo", lazy)
-    flip = img_html(run.output_path("flip_png"), page, f"{run.technique} FLIP map",
-                    CARD_IMAGE_WIDTH, "flipmap", lazy)
-    nums = (f"FLIP {with_bar(fmt_flip(run.final.flip_mean), run.final.flip_sigma, fmt_flip)}"
-            f" · relMSE {fmt_sig(run.final.rel_mse)} · {fmt_ms(run.frame_ms)} ms")
-    if run.vs_full.flip_mean is not None:
-        nums += f"<br>FLIP vs. full reference {fmt_flip(run.vs_full.flip_mean)}"
-    bad = nonfinite_count(run)
-    if bad:
-        nums += f' · <b>{int(bad)} NaN/Inf px</b> <span class="muted">(magenta)</span>'
-    ref = run.reference_label()
-    return (f'<div class="card" style="border-top-color:{color}">'
+    width = CARD_IMAGE_WIDTH
+    figures = [(img_html(run.output_path("final_png"), page, f"{run.technique} final", width,
+                         "expo", lazy), "final")]
+    figures.append((img_html(run.output_path("flip_png"), page, f"{run.technique} FLIP map",
+                             width, "flipmap", lazy),
+                    f"HDR-FLIP map vs {run.reference_label() or 'reference'}"))
+    if run.output_path("indirect_png"):
+        figures.append((img_html(run.output_path("indirect_png"), page,
+                                 f"{run.technique} indirect", width, "expo indirect", lazy),
+                        "indirect (this run)"))
+        ref_indirect = run.reference_path("indirect_png")
+        if ref_indirect:  # older results lack it (the references card says so)
+            figures.append((img_html(ref_indirect, page, "reference indirect", width,
+                                     "expo refindirect", lazy),
+                            f"reference indirect ({run.reference_label() or 'matched'} − "
+                            "emission − direct)"))
+    pair = "".join(f'<figure style="width:{width}px">{img}<figcaption>{esc(cap)}</figcaption>'
+                   "</figure>" for img, cap in figures)
+    return (f'<div class="card" style="border-top-color:{color}" data-key="{esc(run.key)}">'
             f'<div class="card-title">{swatch(run.technique, page)}{badges}</div>'
             f'<div class="card-params">{params_html(run)}</div>'
-            f'<div class="pair"><figure>{final}<figcaption>final</figcaption></figure>'
-            f'<figure>{flip}<figcaption>FLIP error map</figcaption></figure></div>'
-            f'<div class="card-nums">{nums}</div>'
-            + (f'<div class="muted">vs. reference {esc(ref)}</div>' if ref else "")
-            + "</div>")
+            f'<div class="pair">{pair}</div>'
+            f'<div class="card-nums">{_card_numbers(run, page, ties)}</div>'
+            f'<div class="card-links">{_exr_link(run, page)}</div></div>')
+
+
+def _reference_figure(path: str, page: Page, label: str, detail: list[str], css: str) -> str:
+    image = img_html(path, page, f"reference {label}", REF_IMAGE_WIDTH, "expo " + css)
+    return (f'<figure style="width:{REF_IMAGE_WIDTH}px">{image}<figcaption><b>{esc(label)}</b>'
+            f'{"<br>" + esc(", ".join(detail)) if detail else ""}</figcaption></figure>')
 
 
 def _references_html(runs: list[Run], page: Page) -> str:
-    seen: dict[str, Run] = {}
+    """The full reference first, then each bounce-matched reference used on the scene and the
+    full reference's indirect layer (when the runs recorded them)."""
+    full: dict[str, Run] = {}
+    matched: dict[str, Run] = {}
+    indirect: dict[str, Run] = {}
     for run in runs:
-        path = run.reference_png()
-        if path and path not in seen:
-            seen[path] = run
+        for name, seen in (("full_png", full), ("final_png", matched),
+                           ("indirect_full_png", indirect)):
+            path = run.reference_path(name)
+            if path and path not in seen:
+                seen[path] = run
     cards = []
-    for path, run in seen.items():
+    for path in full:
+        cards.append(_reference_figure(path, page, "full reference (all light paths)",
+                                       [], "ref-full"))
+    for path, run in matched.items():
         ref = run.data.get("reference") if isinstance(run.data.get("reference"), dict) else {}
         detail = []
         if num(ref.get("samples")) is not None:
             detail.append(f"{int(num(ref.get('samples')))} spp")
         if num(ref.get("rel_error")) is not None:
             detail.append(f"rel. error {num(ref.get('rel_error')):.3g}")
-        label = run.reference_label() or "reference"
-        image = img_html(path, page, f"reference {label}", REF_IMAGE_WIDTH, "expo")
-        cards.append(f'<figure style="width:{REF_IMAGE_WIDTH}px">{image}<figcaption><b>'
-                     f'{esc(label)}</b>{"<br>" + esc(", ".join(detail)) if detail else ""}'
-                     '</figcaption></figure>')
+        cards.append(_reference_figure(path, page, run.reference_label() or "reference",
+                                       detail, "ref-matched"))
+    for path in indirect:
+        cards.append(_reference_figure(path, page, "full reference's indirect (full − emission "
+                                       "− direct)", [], "ref-indirect"))
     if not cards:
         return ""
+    missing = [what for what, seen in (("the full reference image", full),
+                                       ("the reference indirect layers", indirect)) if not seen]
+    note = (f'<div class="muted">{" and ".join(missing)} '
+            f'{"is" if len(missing) == 1 else "are"} not recorded by these runs (older results)'
+            '</div>' if missing else "")
     return ('<div class="card refs" style="border-top-color:#000"><div class="card-title">'
-            'path-traced reference</div><div class="pair">' + "".join(cards) + "</div></div>")
+            'path-traced reference</div><div class="pair">' + "".join(cards) + "</div>"
+            + note + "</div>")
 
 
 def _exposure_bar() -> str:
@@ -97,18 +179,20 @@ def _scene_resolution(runs: list[Run]) -> str:
 
 def scene_section(scene: str, runs: list[Run], page: Page) -> str:
     measured = [r for r in runs if r.measured]
+    basis = page.basis(scene)
     cards = [_references_html(measured, page)]
     details = []
-    for tech, tech_runs in by_technique(measured).items():
-        best = best_run(tech_runs)
-        if best is None:
-            continue
-        cards.append(_card(best, page, best=True, lazy=False))
-        others = [r for r in tech_runs if r is not best]
+    for best in best_runs(measured, basis):
+        group = [r for r in measured if r.technique == best.technique
+                 and basis.group(r) == basis.group(best)]
+        ties = tied_best(best, [r for r in group if r.status == "ok"], basis.flip,
+                         basis.flip_sigma)
+        cards.append(_card(best, page, best=True, lazy=False, ties=ties))
+        others = [r for r in group if r is not best]
         if others:
-            inner = "".join(_card(r, page, best=False, lazy=True) for r in others)
+            inner = "".join(_card(r, page, best=False, lazy=True, ties=[]) for r in others)
             details.append(f'<details><summary>show the other {len(others)} run'
-                           f'{"s" if len(others) > 1 else ""} of {esc(tech)}</summary>'
+                           f'{"s" if len(others) > 1 else ""} of {esc(best.technique)}</summary>'
                            f'<div class="cards">{inner}</div></details>')
     unsupported = [r for r in runs if r.status == "unsupported"]
     note = ""
@@ -126,8 +210,13 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
              '</h3>')
     if not measured:
         return f'<section class="scene" id="{scene_anchor(scene)}">{title}{note}</section>'
-    return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{_exposure_bar()}'
-            f'<div class="cards">{"".join(cards)}</div>{"".join(details)}{note}</section>')
+    basis_line = (f'<p class="basis-line">Ranked by <b class="basis">{esc(basis.label())}</b>'
+                  + ("" if basis.name != "matched" else
+                     " (no full-reference errors recorded: each technique is ranked against its "
+                     "own bounce-matched reference only)") + ".</p>")
+    return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{basis_line}'
+            f'{_exposure_bar()}<div class="cards">{"".join(cards)}</div>{"".join(details)}'
+            f'{note}</section>')
 
 
 def scenes_html(page: Page) -> str:
@@ -135,11 +224,15 @@ def scenes_html(page: Page) -> str:
     if not any(r.measured for r in page.results.runs):
         return ""
     body = "".join(scene_section(s, runs, page) for s, runs in scenes.items())
-    return ('<h2 id="images">Images</h2><p>Per scene: the path-traced reference (one per set of '
-            'light paths a technique is compared with), then each technique\'s best run (lowest '
-            'mean FLIP against its bounce-matched reference) with its FLIP error map (0 = no '
-            'visible difference, 1 = maximal). Click an image for the full-size file.</p>'
-            + body)
+    return ('<h2 id="images">Images</h2><p>Per scene: the path-traced references (the full one, '
+            'with all light paths, and the bounce-matched ones the techniques claim), then each '
+            'technique\'s best run — lowest mean HDR-FLIP against the <b>full reference</b> — '
+            'with its FLIP error map, its indirect layer next to the reference\'s matching '
+            'indirect layer, and a link to its linear EXR. The first number of a card is the '
+            'ranking basis; the bounce-matched error (the light paths the technique claims) '
+            'and the direct-light error (shared by every technique) follow, each labelled. '
+            '"best (tie)": another run of the technique is within the error bars. Click an '
+            'image for the full-size file.</p>' + body)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -152,17 +245,35 @@ def figure_html(path: str, page: Page, alt: str, caption: str) -> str:
             f'onerror="gilabImageError(this)"></a><figcaption>{caption}</figcaption></figure>')
 
 
-def _front_table(front: list[Run], page: Page) -> str:
-    rows = "".join(f"<tr><td>{swatch(r.technique, page)}</td><td class='params'>"
-                   f"{params_html(r)}</td><td class='n'>{fmt_ms(r.frame_ms)}</td>"
-                   f"<td class='n'>{fmt_flip(page.basis.flip(r))}</td></tr>" for r in front)
-    return ('<table class="data"><thead><tr><th>technique</th><th>parameters</th>'
-            '<th>frame [ms]</th><th>mean FLIP</th></tr></thead><tbody>' + rows +
-            "</tbody></table>")
+def _front_table(front: list[Run], page: Page, scene: str, group: str) -> str:
+    """The front's runs, then the runs tied with it (inseparable within IQR and error bars);
+    every number in the error column is the scene's one basis (data-basis names it)."""
+    basis = page.basis(scene)
+    ties = page.ties.get(scene, {}).get(group, {})
+    runs = page.results.runs
+    tied = [r for r in runs if id(r) in ties]
+    rows = []
+    for run in front + tied:
+        tie = ties.get(id(run))
+        mark = ("front" if tie is None else f"tie with {esc(params_text(tie, True)) or tie.technique}"
+                f" ({esc(tie.technique)})")
+        rows.append(f'<tr data-key="{esc(run.key)}"><td>{swatch(run.technique, page)}</td>'
+                    f"<td class='params'>{params_html(run)}</td><td class='n'>"
+                    f"{with_bar(fmt_ms(run.frame_ms), run.frame_iqr, fmt_ms)}</td>"
+                    f'<td class="n" data-key="{esc(run.key)}" data-basis="{esc(basis.name)}" '
+                    f'data-v="{basis.flip(run)!r}">'
+                    f"{with_bar(fmt_flip(basis.flip(run)), basis.flip_sigma(run), fmt_flip)}</td>"
+                    f"<td>{mark}</td></tr>")
+    measured = [r for r in runs if r.measured and r.scene == scene]
+    return (f'<table class="data ranking" data-basis="{esc(basis.name)}" data-value="error">'
+            f'<thead><tr><th>technique</th><th>parameters</th>'
+            f'<th>{esc(time_label(measured, "frame time"))} ± IQR</th>'
+            f'<th>mean {esc(basis.label("HDR-FLIP", group))}</th><th>on the front</th></tr>'
+            '</thead><tbody>' + "".join(rows) + "</tbody></table>")
 
 
-def _mixed_references_note(runs: list[Run], page: Page) -> str:
-    """A warning when the runs of a scene were compared with different references."""
+def _mixed_references_note(runs: list[Run], page: Page, scene: str) -> str:
+    """Says which bounce-matched references the runs of a scene were compared with."""
     matched: dict[str, list[str]] = {}
     for run in runs:
         if run.measured and run.reference_label():
@@ -173,13 +284,13 @@ def _mixed_references_note(runs: list[Run], page: Page) -> str:
         return ""
     listing = "; ".join(f"{', '.join(swatch(t, page) for t in techs)} → {esc(label)}"
                         for label, techs in matched.items())
-    full = any(b.name == "full" for b in page.bases)
-    return ('<p class="note">Runs on this scene are compared with different bounce-matched '
-            f'references ({listing}). Such an error measures how well a technique renders the '
+    full = page.basis(scene).name == "full"
+    return ('<p class="note">The bounce-matched references differ between runs on this scene '
+            f'({listing}). A bounce-matched error measures how well a technique renders the '
             'light paths it claims: one that leaves out bounces is not penalised for the missing '
-            'light (see the energy ratio), so matched fronts only rank runs compared with the same '
-            'reference' + ('; the lower row compares every run with the full reference.'
-                           if full else '.') + '</p>')
+            'light, so the matched rows only rank runs compared with the same reference'
+            + ('; the top row and every ranking use the full reference.' if full else '.')
+            + '</p>')
 
 
 def _devices_warning(page: Page) -> str:
@@ -196,40 +307,80 @@ def _devices_warning(page: Page) -> str:
 def pareto_html(page: Page) -> str:
     if not page.figures.pareto:
         return ""
-    bars = any(b.flip_sigma(r) is not None or b.rel_mse_sigma(r) is not None
-               for r in page.results.runs for b in page.bases)
-    rows = ("The upper row measures errors against the bounce-matched reference (the light "
-            "paths each technique claims to render), the lower row against the full reference "
-            "(all light paths), where every run of a scene is comparable. "
-            if len(page.bases) > 1 else "")
     parts = ['<h2 id="pareto">Error against frame time</h2><p>Each point is a run; one colour '
-             'per technique. ' + rows + 'Horizontal bars span the frame time\'s interquartile '
-             'range' + ("; vertical bars are ±1σ of the metric from the reference's own noise"
-                        if bars else "") + '. The step line is the Pareto front: the runs '
-             '(ringed) that no other run compared with the same reference beats in both error '
-             'and frame time; fewer than two comparable ok runs have no front. Axes are '
-             'logarithmic when the values span more than 10×.</p>' + _devices_warning(page)]
+             'per technique. The <b>top row</b> is the ranking basis of the scene (mean HDR-FLIP '
+             'and relMSE against the <b>full reference</b>, all light paths, where every run is '
+             'comparable); the row below is the second view, against each run\'s bounce-matched '
+             'reference (the light paths it claims), and a one-bounce row puts the direct '
+             'baseline and one-bounce techniques on one yardstick where both ran. Horizontal '
+             'bars span the frame time\'s interquartile range, vertical bars ±1σ of the metric '
+             'from the reference\'s noise where measured. The step line is the Pareto front: '
+             'the runs (ringed) that no other run compared with the same reference beats in both '
+             'error and frame time. A run whose IQR and error bar both overlap a front run\'s '
+             'cannot be told apart from it: it is marked as a <b>tie</b> (dashed grey ring), '
+             'not as beaten. Axes are logarithmic when the values span more than 10×.</p>'
+             + _devices_warning(page)]
+    scenes = by_scene(page.results.runs)
     for scene, path in page.figures.pareto.items():
+        basis = page.basis(scene)
         parts.append(f"<h3>{esc(scene)}</h3>")
         parts.append(figure_html(path, page, f"error vs frame time, {scene}",
-                                 f"Mean FLIP (left) and relMSE (right) against median frame time "
-                                 f"on {esc(scene)}."))
-        parts.append(_mixed_references_note(by_scene(page.results.runs).get(scene, []), page))
+                                 f"Top row: {esc(basis.label('HDR-FLIP'))} (left) and "
+                                 f"{esc(basis.label('relMSE'))} (right) against median frame "
+                                 f"time on {esc(scene)}."))
+        parts.append(_mixed_references_note(scenes.get(scene, []), page, scene))
         fronts = page.fronts.get(scene, {})
         for label, front in fronts.items():
-            against = f", reference {esc(label)}" if len(fronts) > 1 else ""
-            parts.append(f"<h4>Pareto-optimal runs (mean FLIP {esc(page.basis.caption)}"
-                         f"{against})</h4>" + _front_table(front, page))
+            parts.append(f'<h4>Pareto-optimal runs: mean <span class="basis">'
+                         f'{esc(basis.label("HDR-FLIP", label))}</span></h4>'
+                         + _front_table(front, page, scene, label))
     return "".join(parts)
 
 
+def _series_name(sweep: Sweep, others: tuple) -> str:
+    return ", ".join(f"{k}={v}" for k, v in zip(sweep.other_keys, others)) or "all runs"
+
+
+def sweep_summary(sweep: Sweep, page: Page) -> str:
+    """Per series: how the headline error and the frame time change from the smallest to the
+    largest value of the swept key, called a change only beyond the error bars / IQR."""
+    basis = page.basis(sweep.scene)
+    items = []
+    for others, members in sweep.series.items():
+        ok = [r for r in members if r.status == "ok" and basis.flip(r) is not None]
+        if len(ok) < 2:
+            continue
+        first, last = ok[0], ok[-1]
+        error = change_words(basis.flip(first), basis.flip_sigma(first), basis.flip(last),
+                             basis.flip_sigma(last), fmt_flip)
+        items.append(f"<li>{esc(_series_name(sweep, others))}: from {esc(sweep.key)}="
+                     f"{esc(text(param_value(first, sweep.key)))} to "
+                     f"{esc(text(param_value(last, sweep.key)))}, "
+                     f"{esc(basis.label('HDR-FLIP'))} {esc(error)}; frame time "
+                     f"{esc(time_change_words(first, last, fmt_ms))}</li>")
+    return f'<ul class="trend">{"".join(items)}</ul>' if items else ""
+
+
+def no_effect_html(page: Page) -> str:
+    if not page.figures.no_effect:
+        return ""
+    items = "".join(f'<li class="no-effect">{swatch(s.technique, page)} on {esc(s.scene)}: '
+                    f'<b>{esc(s.key)}</b> has <b>no effect on this scene</b> ({esc(why)}); no '
+                    'figure is drawn.</li>' for s, why in page.figures.no_effect)
+    return f'<h3 id="no-effect">Swept parameters without effect</h3><ul>{items}</ul>'
+
+
 def sweeps_html(page: Page) -> str:
-    if not page.figures.sweeps:
+    if not page.figures.sweeps and not page.figures.no_effect:
         return ""
     parts = ['<h2 id="sweeps">Parameter sweeps</h2><p>Runs of one technique on one scene that '
-             'differ in a swept parameter: error and frame time against that parameter. For '
-             'grids, one line per value of the other swept parameter(s), light to dark. '
-             '✕ marks a run with non-finite output.</p>']
+             'differ in a swept parameter: the scene\'s ranking error (HDR-FLIP vs the full '
+             'reference), the bounce-matched error, relMSE and the frame time (bars: its IQR) '
+             'against that parameter. For grids, one line per value of the other swept '
+             'parameter(s), light to dark. ✕ marks a run with non-finite output. A change is '
+             'only called a rise or a fall when the error bars (error) or the IQRs (time) of '
+             'the two ends do not overlap. A parameter whose runs give identical images is '
+             'reported as having no effect on the scene.</p>']
     for sweep, path in page.figures.sweeps:
         n = sum(len(m) for m in sweep.series.values())
         others = (f"; one line per {esc(', '.join(sweep.other_keys))}" if sweep.other_keys
@@ -237,20 +388,22 @@ def sweeps_html(page: Page) -> str:
         parts.append(figure_html(
             path, page, f"sweep {sweep.technique} {sweep.scene} {sweep.key}",
             f"{swatch(sweep.technique, page)} on {esc(sweep.scene)}: "
-            f"<b>{esc(sweep.key)}</b> ({n} runs{others})."))
+            f"<b>{esc(sweep.key)}</b> ({n} runs{others})." + sweep_summary(sweep, page)))
+    parts.append(no_effect_html(page))
     return "".join(parts)
 
 
 def passes_html(page: Page) -> str:
     if not page.figures.passes:
         return ""
+    device = device_label([r for r in page.results.runs if r.measured])
     parts = ['<h2 id="passes">Time per pass</h2><p>For each technique\'s best run per scene: '
-             'the median GPU time of every pass of a frame, stacked (left), and the one-time '
-             'set-up cost by stage, CPU wall clock (right). Totals above the bars.</p>']
+             f'the median time of every pass of a frame on {esc(device)}, stacked (left), and '
+             'the one-time set-up cost by stage, wall clock (right). Totals above the bars.</p>']
     for scene, path in page.figures.passes.items():
         parts.append(f"<h3>{esc(scene)}</h3>")
         parts.append(figure_html(path, page, f"time per pass, {scene}",
-                                 f"Per-pass GPU time and set-up time on {esc(scene)}."))
+                                 f"Per-pass time ({esc(device)}) and set-up time on {esc(scene)}."))
     return "".join(parts)
 
 

@@ -12,9 +12,11 @@ from report_analysis import (MIN_COMPARED, best_within_budget, by_scene, by_tech
                              cheapest_reaching, comparable_groups, error_targets, ordered_unique,
                              params_text, slug, time_budgets)
 from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html, fmt_fixed,
-                           fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, status_badge,
-                           swatch, validation_summary, with_bar)
+                           fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, rel_url,
+                           status_badge, swatch, validation_summary, with_bar)
 from report_data import Results, Run, dig, num, text
+from report_device import device_note_html, time_label
+from report_noise import error_separable, time_separable
 
 
 # ---------------------------------------------------------------------------------------------
@@ -74,6 +76,9 @@ def header_html(page: Page) -> str:
     overhead = _instrumentation(page)
     if overhead:
         rows.append(("timer overhead", overhead))
+    note = device_note_html([r for r in runs if r.measured])
+    if note:
+        rows.append(("timings", f'<span class="device-note">{note}</span>'))
     rows.append(("results", "<br>".join(esc(d) for d in res.dirs)))
     rows.append(("runs", counts_html(page)))
     meta = "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows)
@@ -93,11 +98,14 @@ def _instrumentation(page: Page) -> str:
             parts.append(f"not measured: {esc(probe.get('skipped'))}")
             continue
         ms, iqr = num(probe.get("overhead_ms")), num(probe.get("overhead_iqr_ms"))
-        if ms is not None:
-            parts.append(f"{with_bar(fmt_ms(ms), iqr, fmt_ms)} ms per frame "
-                         f"<span class='muted'>({esc(probe.get('technique'))} on "
-                         f"{esc(probe.get('scene'))}, CPU frame time with − without timestamp "
-                         "queries)</span>")
+        where = (f"<span class='muted'>({esc(probe.get('technique'))} on "
+                 f"{esc(probe.get('scene'))}, CPU frame time with − without timestamp "
+                 "queries)</span>")
+        if ms is not None and (iqr is None or abs(ms) > iqr):
+            parts.append(f"{with_bar(fmt_ms(ms), iqr, fmt_ms)} ms per frame {where}")
+        elif ms is not None:
+            parts.append(f"not measurable: the difference is within its IQR (± {fmt_ms(iqr)} "
+                         f"ms) {where}")
     return "; ".join(ordered_unique(parts))
 
 
@@ -170,7 +178,7 @@ def _memory_cell(run: Run) -> tuple[str, object]:
 def _frame_cell(run: Run) -> tuple[str, object]:
     shown = with_bar(fmt_ms(run.frame_ms), run.frame_iqr, fmt_ms)
     if run.frame_source == "cpu":
-        shown += ' <span class="pm">(CPU)</span>'
+        shown += ' <span class="pm">(CPU clock)</span>'
     return shown, run.frame_ms
 
 
@@ -203,67 +211,103 @@ def _reference_cell(run: Run) -> tuple[str, object]:
 
 
 def _front_cell(run: Run, page: Page) -> tuple[str, object]:
-    on = any(run is r for front in page.fronts.get(run.scene, {}).values() for r in front)
-    return ('<span class="badge b-front">front</span>', 1) if on else ("", 0)
+    if page.on_front(run):
+        return '<span class="badge b-front">front</span>', 2
+    if page.tie_of(run) is not None:
+        return '<span class="badge b-tie">tie</span>', 1
+    return "", 0
+
+
+def _exr_cell(run: Run, page: Page) -> tuple[str, object]:
+    path = run.output_path("exr")
+    if not path:
+        return DASH, None
+    if not os.path.isfile(path):
+        return '<span class="muted">missing</span>', None
+    return f'<a class="exr" href="{rel_url(path, page.out_dir)}">EXR</a>', "exr"
+
+
+def _flip_cell(view: Callable[[Run], object]) -> Callable[[Run], tuple[str, object]]:
+    def cell(run: Run) -> tuple[str, object]:
+        m = view(run)
+        return _n(m.flip_mean, with_bar(fmt_flip(m.flip_mean), m.flip_sigma, fmt_flip))
+    return cell
+
+
+def _relmse_cell(view: Callable[[Run], object]) -> Callable[[Run], tuple[str, object]]:
+    def cell(run: Run) -> tuple[str, object]:
+        m = view(run)
+        return _n(m.rel_mse, with_bar(fmt_sig(m.rel_mse), m.rel_mse_sigma, fmt_sig))
+    return cell
 
 
 def run_columns(page: Page) -> list[Column]:
-    """The run table's columns: identity, error, then cost; those no run has are dropped."""
+    """The run table's columns: identity, error (full reference first: the ranking basis),
+    then cost; those no run has are dropped."""
     runs = page.results.runs
+    measured = [r for r in runs if r.measured]
+    frame = time_label(measured, "frame time")
     cols = [
+        Column("technique", "technique", "technique id",
+               lambda r: (swatch(r.technique, page), r.technique), False, "tech"),
         Column("index", "#", "run index in the experiment", lambda r: _n(r.index, text(r.index))),
         Column("scene", "scene", "scene label", lambda r: (esc(r.scene), r.scene), False, ""),
-        Column("technique", "technique", "technique id",
-               lambda r: (swatch(r.technique, page), r.technique), False, ""),
-        Column("params", "parameters", "technique parameters (swept ones in bold)",
-               lambda r: (params_html(r), params_text(r)), False, "params"),
+        Column("params", "parameters", "technique parameters: the swept ones, the others one "
+               "click away", lambda r: (params_html(r), params_text(r)), False, "params"),
         Column("status", "status", "ok / nonfinite / unsupported (with the reason) / invalid "
                "(Vulkan validation reported errors or warnings: numbers not trusted, not ranked)",
                _status_cell, False, "reason"),
-        Column("frame", "frame [ms]", "median frame time over the timed frames ± IQR "
-               "(GPU: sum of pass timestamps)", _frame_cell),
-        Column("flip", "mean FLIP", "mean HDR-FLIP of the final image against the "
-               "bounce-matched reference (↓); ± 1σ from the reference's noise",
-               lambda r: _n(r.final.flip_mean, with_bar(fmt_flip(r.final.flip_mean),
-                                                         r.final.flip_sigma, fmt_flip))),
-        Column("relmse", "relMSE", "relative MSE of the linear images against the bounce-matched "
-               "reference (↓); ± 1σ",
-               lambda r: _n(r.final.rel_mse, with_bar(fmt_sig(r.final.rel_mse),
-                                                       r.final.rel_mse_sigma, fmt_sig))),
-        Column("psnr", "PSNR LDR [dB]", "PSNR of the tonemapped 8-bit images (↑); ± 1σ",
+        Column("frame", f"{frame} ± IQR", "median frame time over the timed frames ± IQR "
+               "(sum of the passes' timestamps on the device named)", _frame_cell),
+        Column("flip_full", "HDR-FLIP vs full reference", "mean HDR-FLIP of the final image "
+               "against the full reference (all light paths): the ranking basis (↓)",
+               _flip_cell(lambda r: r.vs_full)),
+        Column("relmse_full", "relMSE vs full reference", "relMSE against the full reference "
+               "(↓); ± 1σ", _relmse_cell(lambda r: r.vs_full)),
+        Column("flip", "HDR-FLIP vs bounce-matched reference", "mean HDR-FLIP of the final image "
+               "against the bounce-matched reference (the light paths the technique claims, see "
+               "the reference column) (↓); ± 1σ from the reference's noise",
+               _flip_cell(lambda r: r.final)),
+        Column("relmse", "relMSE vs bounce-matched reference", "relative MSE of the linear "
+               "images against the bounce-matched reference (↓); ± 1σ",
+               _relmse_cell(lambda r: r.final)),
+        Column("flip_direct", "direct light: HDR-FLIP vs emission+direct", "mean HDR-FLIP of "
+               "the technique's direct-light layer against the reference's emission + direct "
+               "(shared by every technique) (↓)", _flip_cell(lambda r: r.direct)),
+        Column("psnr", "PSNR LDR vs bounce-matched [dB]", "PSNR of the tonemapped 8-bit images "
+               "against the bounce-matched reference (↑); ± 1σ",
                lambda r: _n(r.final.psnr_ldr, with_bar(fmt_fixed(r.final.psnr_ldr, 2),
                                                         r.final.psnr_ldr_sigma,
                                                         lambda x: fmt_fixed(x, 2)))),
-        Column("ssim", "SSIM", "SSIM of the tonemapped luma (↑)",
+        Column("ssim", "SSIM vs bounce-matched", "SSIM of the tonemapped luma against the "
+               "bounce-matched reference (↑)",
                lambda r: _n(r.final.ssim, fmt_fixed(r.final.ssim, 4))),
-        Column("flip_full", "FLIP vs full", "mean HDR-FLIP against the full reference (all light "
-               "paths, whatever the technique claims) (↓)",
-               lambda r: _n(r.vs_full.flip_mean, fmt_flip(r.vs_full.flip_mean))),
-        Column("relmse_full", "relMSE vs full", "relMSE against the full reference (↓); ± 1σ",
-               lambda r: _n(r.vs_full.rel_mse, with_bar(fmt_sig(r.vs_full.rel_mse),
-                                                         r.vs_full.rel_mse_sigma, fmt_sig))),
         *_region_columns(runs),
-        Column("flip_indirect", "FLIP indirect", "mean HDR-FLIP of the indirect layer against "
-               "the reference's indirect layer",
+        Column("flip_indirect", "indirect: HDR-FLIP vs matched indirect", "mean HDR-FLIP of the "
+               "indirect layer against the bounce-matched reference's indirect layer",
                lambda r: _n(r.indirect.flip_mean, fmt_flip(r.indirect.flip_mean))),
         Column("energy", "energy ratio", "mean luminance of the indirect layer over the "
                "reference's (1 = the right amount of indirect light)",
                lambda r: _n(r.energy_ratio, fmt_fixed(r.energy_ratio, 3))),
         Column("nonfinite", "NaN/Inf px", "NaN or Inf pixels in the final image",
                lambda r: _n(nonfinite_count(r), fmt_sig(nonfinite_count(r), 6))),
-        Column("noise", "within ref. noise", "whether the error is no larger than what the "
-               "reference's own Monte Carlo noise produces (MSE and/or FLIP)", _noise_cell, True,
-               ""),
-        Column("front", "Pareto", f"on its scene's Pareto front (mean FLIP {page.basis.caption} "
-               "vs. frame time)", lambda r: _front_cell(r, page), True, ""),
-        Column("setup", "set-up [ms]", "one-time set-up, CPU wall clock (timing.setup_ms.total)",
-               lambda r: _n(r.setup_ms, fmt_ms(r.setup_ms))),
-        Column("passes", "passes [ms]", "median GPU time of each pass (sorts by their sum)",
-               _passes_cell, True, "passes"),
-        Column("memory", "memory [MiB]", "GPU memory allocated by gilab (total; peak if higher)",
-               _memory_cell),
-        Column("reference", "reference", "light paths of the matched reference, samples per "
-               "pixel", _reference_cell, False, ""),
+        Column("noise", "within ref. noise", "whether the error against the bounce-matched "
+               "reference is no larger than what the reference's own Monte Carlo noise produces "
+               "(MSE and/or FLIP)", _noise_cell, True, ""),
+        Column("front", "Pareto", "on its scene's Pareto front (mean HDR-FLIP against the "
+               "scene's ranking basis, the full reference where measured, vs. frame time); "
+               "'tie': inseparable from a front run within IQR and error bars",
+               lambda r: _front_cell(r, page), True, ""),
+        Column("setup", time_label(measured, "set-up (wall clock)"), "one-time set-up, wall "
+               "clock (timing.setup_ms.total)", lambda r: _n(r.setup_ms, fmt_ms(r.setup_ms))),
+        Column("passes", time_label(measured, "passes"), "median time of each pass on the "
+               "device named (sorts by their sum)", _passes_cell, True, "passes"),
+        Column("memory", "memory [MiB]", "device memory allocated by gilab (total; peak if "
+               "higher)", _memory_cell),
+        Column("exr", "EXR", "the run's linear output (outputs.exr)",
+               lambda r: _exr_cell(r, page), False, ""),
+        Column("reference", "bounce-matched reference", "light paths of the matched reference, "
+               "samples per pixel", _reference_cell, False, ""),
     ]
     return _applicable(cols, runs, page)
 
@@ -356,17 +400,31 @@ def failures_html(page: Page) -> str:
 # Section 7: equal-time and equal-error tables
 # ---------------------------------------------------------------------------------------------
 
-def _equal_table(page: Page, runs: list[Run], headers: list[str],
-                 pick: Callable[[list[Run], int], Optional[Run]],
-                 show: Callable[[Run], str], value: Callable[[Run], float]) -> str:
+@dataclass
+class Ranking:
+    """One equal-time or equal-error table: which run each cell shows and how it is compared."""
+
+    headers: list[str]
+    pick: Callable[[list[Run], int], Optional[Run]]
+    show: Callable[[Run], str]
+    value: Callable[[Run], float]
+    tied: Callable[[Run, Run], bool]  # inseparable within the noise
+    basis_name: str
+    corner: str  # the header of the first column (names the basis / device)
+    shows: str  # "error" or "time": what the cells' data-v holds
+
+
+def _equal_table(page: Page, runs: list[Run], table: Ranking) -> str:
+    """Techniques × constraints; the best cell of each column highlighted, and every cell that
+    cannot be told apart from it within the noise marked as tied with it."""
     techs = by_technique([r for r in runs if r.status == "ok"])
-    winners: dict[int, float] = {}
+    winners: dict[int, Run] = {}
     picks: dict[str, list[Optional[Run]]] = {}
     for tech, tech_runs in techs.items():
-        picks[tech] = [pick(tech_runs, i) for i in range(len(headers))]
+        picks[tech] = [table.pick(tech_runs, i) for i in range(len(table.headers))]
         for i, run in enumerate(picks[tech]):
-            if run is not None and (i not in winners or value(run) < winners[i]):
-                winners[i] = value(run)
+            if run is not None and (i not in winners or table.value(run) < table.value(winners[i])):
+                winners[i] = run
     rows = []
     for tech, chosen in picks.items():
         cells = []
@@ -374,27 +432,40 @@ def _equal_table(page: Page, runs: list[Run], headers: list[str],
             if run is None:
                 cells.append(f'<td class="n">{DASH}</td>')
                 continue
-            best = " best" if value(run) == winners.get(i) else ""
-            cells.append(f'<td class="n{best}" title="{esc(params_text(run))}">{show(run)}</td>')
+            best = winners.get(i)
+            css = " best" if run is best else (" best tie" if table.tied(run, best) else "")
+            mark = ' <span class="pm">(tie)</span>' if css == " best tie" else ""
+            cells.append(f'<td class="n{css}" data-key="{esc(run.key)}" '
+                         f'data-basis="{esc(table.basis_name)}" data-v="{table.value(run)!r}" '
+                         f'title="{esc(params_text(run))}">{table.show(run)}{mark}</td>')
         rows.append(f"<tr><td>{swatch(tech, page)}</td>{''.join(cells)}</tr>")
-    head = "".join(f'<th>{h}</th>' for h in headers)
-    return (f'<table class="data"><thead><tr><th>technique</th>{head}</tr></thead>'
+    head = "".join(f'<th>{esc(h)}</th>' for h in table.headers)
+    return (f'<table class="data ranking" data-basis="{esc(table.basis_name)}" '
+            f'data-value="{table.shows}"><thead><tr><th>{esc(table.corner)}</th>{head}</tr></thead>'
             f'<tbody>{"".join(rows)}</tbody></table>')
 
 
-def _equal_group_html(page: Page, ok: list[Run]) -> str:
+def _equal_group_html(page: Page, ok: list[Run], scene: str, group: str) -> str:
     """The equal-time and equal-error tables of runs compared with one reference."""
-    basis = page.basis
+    basis = page.basis(scene)
     budgets = time_budgets([r.frame_ms for r in ok])
     targets = error_targets([basis.flip(r) for r in ok])
-    return ("<h4>Equal time: lowest mean FLIP within a frame-time budget</h4>"
-            + _equal_table(page, ok, [f"≤ {b:g} ms" for b in budgets],
-                           lambda rs, i: best_within_budget(rs, budgets[i], basis),
-                           lambda r: fmt_flip(basis.flip(r)), basis.flip)
-            + "<h4>Equal error: shortest frame time reaching a mean FLIP</h4>"
-            + _equal_table(page, ok, [f"FLIP ≤ {t:g}" for t in targets],
-                           lambda rs, i: cheapest_reaching(rs, targets[i], basis),
-                           lambda r: fmt_ms(r.frame_ms) + " ms", lambda r: r.frame_ms))
+    flip_label = basis.label("HDR-FLIP", group)
+    frame = time_label(ok, "frame time")
+    error_tied = lambda a, b: not error_separable(a, b, basis.flip, basis.flip_sigma)  # noqa
+    time_tied = lambda a, b: not time_separable(a, b)  # noqa: E731
+    equal_time = Ranking([f"≤ {b:g} ms" for b in budgets],
+                         lambda rs, i: best_within_budget(rs, budgets[i], basis),
+                         lambda r: fmt_flip(basis.flip(r)), basis.flip, error_tied, basis.name,
+                         f"mean {flip_label}, by {frame} budget", "error")
+    equal_error = Ranking([f"≤ {t:g}" for t in targets],
+                          lambda rs, i: cheapest_reaching(rs, targets[i], basis),
+                          lambda r: fmt_ms(r.frame_ms), lambda r: r.frame_ms, time_tied,
+                          basis.name, f"{frame}, by mean {flip_label} target", "time")
+    return (f'<h4>Equal time: lowest mean <span class="basis">{esc(flip_label)}</span> within a '
+            f'budget of {esc(frame)}</h4>' + _equal_table(page, ok, equal_time)
+            + f'<h4>Equal error: shortest {esc(frame)} reaching a mean <span class="basis">'
+            f'{esc(flip_label)}</span></h4>' + _equal_table(page, ok, equal_error))
 
 
 def _left_out_note(runs: list[Run], groups: dict[str, list[Run]], page: Page) -> str:
@@ -402,35 +473,34 @@ def _left_out_note(runs: list[Run], groups: dict[str, list[Run]], page: Page) ->
                       - {r.technique for g in groups.values() for r in g})
     if not left_out:
         return ""
-    return (f'<p class="note">not in this comparison (no ok run with a time and an error, or '
-            f'fewer than {MIN_COMPARED} runs compared with its reference): '
+    return (f'<p class="note">not in this comparison (no ok run with a time and an error on '
+            f'this basis, or fewer than {MIN_COMPARED} runs compared with its reference): '
             + ", ".join(swatch(t, page) for t in left_out) + "</p>")
 
 
 def equal_html(page: Page) -> str:
     parts = []
     for scene, runs in by_scene(page.results.runs).items():
-        groups = comparable_groups(runs, page.basis)
+        basis = page.basis(scene)
+        groups = comparable_groups(runs, basis)
         if not groups:
             continue
         parts.append(f"<h3>{esc(scene)}</h3>")
         for label, ok in groups.items():
-            if page.basis.name == "matched":
-                parts.append(f'<p class="note">runs compared with the reference <b>{esc(label)}'
-                             '</b></p>')
-            parts.append(_equal_group_html(page, ok))
+            parts.append(_equal_group_html(page, ok, scene, label))
         parts.append(_left_out_note(runs, groups, page))
     if not parts:
         return ""
-    among = ("every run of a scene, with mean FLIP against the full reference (all light paths)"
-             if page.basis.name == "full" else
-             "the runs of a scene compared with the same bounce-matched reference")
-    return ('<h2 id="equal">Equal-time and equal-error comparison</h2><p>Among ' + among +
-            '. Budgets are the 1-2-5 series of milliseconds covering the observed median frame '
-            'times; target errors are the 90/75/50/25/10 % quantiles of the observed mean FLIP '
-            'values (2 significant digits). Each cell is the technique\'s best ok run under that '
-            'constraint (hover for its parameters); the best technique in each column is '
-            f'highlighted; {DASH} = no run qualifies.</p>' + "".join(parts))
+    return ('<h2 id="equal">Equal-time and equal-error comparison</h2><p>Per scene, every run '
+            'is compared on the scene\'s one ranking basis, named in each heading: mean HDR-FLIP '
+            'against the <b>full reference</b> (all light paths) where measured; results without '
+            'it are compared only with runs of the same bounce-matched reference. Budgets are '
+            'the 1-2-5 series of milliseconds covering the observed median frame times; target '
+            'errors are the 90/75/50/25/10 % quantiles of the observed values (2 significant '
+            'digits). Each cell is the technique\'s best ok run under that constraint (hover '
+            'for its parameters); the best cell of each column is highlighted, and cells that '
+            'cannot be told apart from it (error bars or frame-time IQRs overlap) are marked '
+            f'"(tie)"; {DASH} = no run qualifies.</p>' + "".join(parts))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -491,35 +561,49 @@ def unreadable_html(page: Page) -> str:
 
 def footer_html(page: Page) -> str:
     definitions = [
-        ("Frame time", "median over the timed frames (warm-up frames discarded) of the GPU frame "
-         "time, the sum of the per-pass timestamp intervals; ± is the interquartile range "
-         "(q3 − q1). Runs without GPU timings use the CPU frame time, marked (CPU). See "
-         + doc_link(page, "timing.md") + "."),
-        ("Set-up time", "CPU wall clock of the one-time set-up (scene upload, shared passes, "
+        ("Frame time", "median over the timed frames (warm-up frames discarded) of the frame "
+         "time, the sum of the per-pass timestamp intervals on the device named in every time "
+         "axis and header (\u201clavapipe (CPU)\u201d: Vulkan on the llvmpipe CPU rasteriser, "
+         "not a GPU); ± is the interquartile range (q3 − q1). Runs without timestamps use the "
+         "CPU frame time, marked (CPU clock). See " + doc_link(page, "timing.md") + "."),
+        ("Set-up time", "wall clock of the one-time set-up (scene upload, shared passes, "
          "shadow maps, technique set-up), <code>timing.setup_ms.total</code>."),
-        ("Memory", "bytes of GPU memory allocated through gilab's accounting, in MiB "
+        ("Memory", "bytes of device memory allocated through gilab's accounting, in MiB "
          "(2<sup>20</sup> bytes); the peak is shown when higher than the final total."),
-        ("Errors", "mean FLIP, relMSE, PSNR (LDR) and SSIM of the final image against the "
-         "path-traced reference with the light paths the technique claims (emission, direct and "
-         "its number of indirect bounces: the <i>bounce-matched</i> reference); the columns "
-         "\u201cvs full\u201d against the <i>full</i> reference (all light paths). relMSE on "
-         "linear values, PSNR (LDR) and SSIM on the tonemapped 8-bit images, FLIP is HDR-FLIP. "
-         "Definitions in " + doc_link(page, "metrics.md") + ". Error bars (±1σ) come from "
-         "re-sampling the reference's per-pixel standard error. <i>Within the reference's "
-         "noise</i>: MSE ≤ 2 × the reference's noise floor (MSE), or FLIP ≤ the FLIP of a "
-         "noise-only image + 2 of its standard deviations (FLIP)."),
-        ("Best run", "per technique and scene: the ok run with the lowest mean FLIP against the "
-         "bounce-matched reference (ties: lower relMSE, then shorter frame time)."),
-        ("Ranking", f"fronts and equal-time/error tables use the mean FLIP "
-         f"{esc(page.basis.caption)}, among the ok runs of one scene compared with the same "
-         "reference (at least two runs)."),
+        ("Ranking basis", "every headline number and ranking of a scene (best run, Pareto "
+         "front, equal-time and equal-error tables, image-card numbers, the top row of the "
+         "error-vs-time figure) uses one basis, named in its label: mean HDR-FLIP <i>vs full "
+         "reference</i> (all light paths, <code>metrics.final_vs_full</code>), so a technique "
+         "that leaves out bounces pays for the missing light. Results without it fall back to the "
+         "bounce-matched reference, ranking only runs compared with the same one. No ranking "
+         "mixes references."),
+        ("Errors", "\u201cvs bounce-matched reference\u201d: against the path-traced reference "
+         "with the light paths the technique claims (emission, direct and its number of "
+         "indirect bounces; <code>metrics.final</code>), the error of what it claims to render, "
+         "a second view. \u201cdirect light\u201d: the direct-light layer against the "
+         "reference's emission + direct (<code>metrics.direct</code>), shared by every "
+         "technique. relMSE on linear values, PSNR (LDR) and SSIM on the tonemapped 8-bit "
+         "images, FLIP is HDR-FLIP. Definitions in " + doc_link(page, "metrics.md") + ". Error "
+         "bars (±1σ) come from re-sampling the reference's per-pixel standard error. <i>Within "
+         "the reference's noise</i>: MSE ≤ 2 × the reference's noise floor (MSE), or FLIP ≤ the "
+         "FLIP of a noise-only image + 2 of its standard deviations (FLIP)."),
+        ("Noise", "two runs are told apart only when their frame-time IQRs or their error "
+         "intervals (± 1σ; a point where no error bar is measured) do not overlap. A best run "
+         "with another within its error bars is \u201cbest (tie)\u201d; a run whose IQR and "
+         "error bar both overlap a front run's is a tie with the front; sweep summaries call a "
+         "change a rise or fall only beyond the bars."),
+        ("Best run", "per technique and scene: the ok run with the lowest mean HDR-FLIP on the "
+         "scene's ranking basis (ties: lower relMSE, then shorter frame time)."),
         ("Pareto front", "the runs for which no other run has both a frame time ≤ and an error "
-         "<."),
-        ("Equal time / equal error", "equal time: for each budget B, the lowest mean FLIP among "
-         "the technique's runs with median frame time ≤ B (budgets: the 1-2-5 series of ms "
-         "covering the observed times). Equal error: for each target E, the shortest median "
-         "frame time among its runs with mean FLIP ≤ E (targets: the 90/75/50/25/10 % quantiles "
-         "of the observed values)."),
+         "<; runs inseparable from a front run are listed as ties."),
+        ("No effect", "a swept parameter whose runs (differing only in it) have identical output "
+         "images, or identical metrics where no image is readable, has no effect on the scene: "
+         "no sweep figure, a note instead."),
+        ("Equal time / equal error", "equal time: for each budget B, the lowest mean HDR-FLIP "
+         "among the technique's runs with median frame time ≤ B (budgets: the 1-2-5 series of "
+         "ms covering the observed times). Equal error: for each target E, the shortest median "
+         "frame time among its runs with mean HDR-FLIP ≤ E (targets: the 90/75/50/25/10 % "
+         "quantiles of the observed values)."),
         ("Report", f"generated {esc(page.generated)} by <code>scripts/report/make_report.py"
          f"</code> ({esc(page.tool_versions)}); described in " + doc_link(page, "report.md")
          + "."),

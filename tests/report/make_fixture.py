@@ -15,10 +15,16 @@ Contents (schema 1, see scripts/report/report_data.py for what the report reads)
               malformed result.json, one in-progress folder (.tmp-...) the report must ignore
   metrics     final (vs. the bounce-matched reference), final_vs_full, indirect (techniques with
               bounces), regions, energy_ratio; key names as experiments/metrics toJson writes them
-  images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), and final/indirect/flip
-              PNGs per run (EXR files are listed in "outputs" as the runner does but not written)
-With --no-sweeps: tech_a and tech_b have one run per scene and nothing is swept, and there are no
-regions, no error bars and no final_vs_full (for checking that those parts are left out).
+  images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), full.png (the full
+              reference) and <name>.indirect.png (reference minus emission+direct), and
+              final/indirect/flip PNGs per run; the EXR files are placeholders (magic number only)
+  device      lavapipe (device.type "cpu"), as the project's own results
+  no-op sweep direct sweeps shared.area_light_samples (4, 16): it changes cornell_box (area
+              light) and nothing on sponza#sun (identical images and metrics)
+With --no-sweeps: every technique has one run per scene and nothing is swept, and there are no
+regions, no error bars, no final_vs_full, no metrics.direct, no full reference or reference
+indirect layers (an older runner), and the device is a GPU (for checking that those parts are left
+out or labelled accordingly).
 The numbers are made up but consistent: more cones / voxels / steps = lower error, more time.
 """
 from __future__ import annotations
@@ -74,6 +80,7 @@ class Spec:
     index: int = 0
     notes: list[str] = field(default_factory=list)
     validation: list[str] = field(default_factory=list)  # messages; any makes it "invalid"
+    shared: dict = field(default_factory=dict)  # swept shared-pass parameters (shared.<name>)
 
 
 def run_specs(sweeps: bool) -> list[Spec]:
@@ -82,9 +89,12 @@ def run_specs(sweeps: bool) -> list[Spec]:
     grid = [(v, s) for v in (32, 64, 128) for s in (8, 16)] if sweeps else [(64, 16)]
     swept_a = ["cone_count"] if sweeps else []
     swept_b = ["voxel_res", "steps"] if sweeps else []
+    samples = [4, 16] if sweeps else [16]
     for scene in SCENES:
-        specs.append(Spec(scene, "direct", {}, [],
-                          notes=["direct: baseline: indirect layer is zero by construction"]))
+        for n in samples:  # no effect on sponza#sun (no area light): identical outputs
+            specs.append(Spec(scene, "direct", {}, ["shared.area_light_samples"] if sweeps else [],
+                              notes=["direct: baseline: indirect layer is zero by construction"],
+                              shared={"area_light_samples": n}))
         for n in cones:
             bad = sweeps and scene == "sponza#sun" and n == 16
             specs.append(Spec(scene, "tech_a", {"cone_count": n, "max_distance": 1.5}, swept_a,
@@ -115,10 +125,16 @@ def scene_factor(scene: str) -> float:
     return 1.0 if scene == "cornell_box" else 1.2
 
 
+def area_lit(scene: str) -> bool:
+    """The fixture's cornell_box has an area light (its samples matter), sponza#sun has not."""
+    return scene == "cornell_box"
+
+
 def flip_of(spec: Spec) -> float:
     p = spec.params
     if spec.technique == "direct":  # against the emission+direct reference: small error
-        base = 0.06
+        samples = spec.shared.get("area_light_samples", 16)
+        base = 0.06 + (0.08 / samples if area_lit(spec.scene) else 0.0)
     elif spec.technique == "tech_a":
         base = 0.05 + 0.20 / math.sqrt(p["cone_count"])
     else:
@@ -260,7 +276,8 @@ def technique_images(spec: Spec, flip: float, rng: np.random.Generator
     direct, indirect = reference_layers(spec.scene)
     if spec.technique == "direct":  # no indirect light; the shared direct pass is a bit dark
         noisy = np.zeros_like(indirect)
-        direct = direct * 0.94
+        samples = spec.shared.get("area_light_samples", 16)
+        direct = direct * (0.94 - (0.2 / samples if area_lit(spec.scene) else 0.0))
     else:
         noisy = indirect * (1.0 - flip) + rng.normal(0.0, flip * 0.12, indirect.shape)
     if spec.technique == "tech_b":  # blocky, like a coarse voxel grid
@@ -293,11 +310,26 @@ def safe_label(label: str) -> str:
 
 
 def run_key(spec: Spec) -> str:
-    blob = json.dumps([spec.scene, spec.technique, spec.params], sort_keys=True)
+    blob = json.dumps([spec.scene, spec.technique, spec.params, spec.shared], sort_keys=True)
     return hashlib.sha1(blob.encode()).hexdigest()[:16]
 
 
-def base_result(spec: Spec, key: str) -> dict:
+# The main fixture ran on lavapipe (a CPU device, like the project's own results); the flat one
+# on a GPU, so both kinds of time labels are checked.
+LAVAPIPE = {"name": "llvmpipe (LLVM 15.0.6, 256 bits)", "type": "cpu", "driver": "llvmpipe",
+            "driver_info": "Mesa 22.3.6 (LLVM 15.0.6)", "vulkan_api": "1.3.230"}
+GPU = {"name": "Fixture GPU (synthetic)", "type": "discrete", "driver": "fixture",
+       "driver_info": "synthetic 1.0", "vulkan_api": "1.3.280"}
+EXR_MAGIC = b"v/1\x01"  # the fixture's EXR files are placeholders: magic number only
+
+
+def direct_layer_flip(spec: Spec) -> float:
+    """The shared direct-light layer against emission+direct: the same for every technique."""
+    samples = spec.shared.get("area_light_samples", 16)
+    return 0.03 * scene_factor(spec.scene) + (0.08 / samples if area_lit(spec.scene) else 0.0)
+
+
+def base_result(spec: Spec, key: str, cpu: bool) -> dict:
     w, h = SCENES[spec.scene]
     variant = spec.scene.partition("#")[2]
     return {
@@ -309,16 +341,17 @@ def base_result(spec: Spec, key: str) -> dict:
                       "citation": "none (test fixture)",
                       "indirect_bounces": bounces(spec.technique),
                       "params": spec.params,
-                      "swept": {k: str(spec.params[k]) for k in spec.swept}},
-        "shared_params": {"shadows": True, "shadow_resolution": 1024, "area_light_samples": 16},
+                      "swept": {k: str(spec.params[k] if k in spec.params else
+                                       spec.shared[k.partition(".")[2]]) for k in spec.swept}},
+        "shared_params": {"shadows": True, "shadow_resolution": 1024, "area_light_samples": 16,
+                          **spec.shared},
         "provenance": {"gilab_version": "0.1.0",
                        "git_commit": "a1b2c3d4e5f6" if spec.index < 12 else "0f9e8d7c6b5a",
                        "build_type": "Release", "compiler": "GNU 12.2.0",
                        "date": f"2026-11-{20 + spec.index // 12:02d}T10:{spec.index % 60:02d}:00Z",
                        "host": "fixture-host", "cpu": "Synthetic CPU", "hardware_threads": 2,
                        "command_line": "gilab run experiments/configs/fixture.json"},
-        "device": {"name": "Fixture GPU (synthetic)", "type": "discrete", "driver": "fixture",
-                   "driver_info": "synthetic 1.0", "vulkan_api": "1.3.280"},
+        "device": dict(LAVAPIPE if cpu else GPU),
         "skipped_passes": SKIPPED[spec.scene] + (["tech_b/temporal: temporal=false"]
                                                  if spec.technique == "tech_b" else []),
         "notes": spec.notes,
@@ -363,7 +396,7 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
     key = run_key(spec)
     folder = os.path.join(root, "runs", key)
     os.makedirs(folder, exist_ok=True)
-    result = base_result(spec, key)
+    result = base_result(spec, key, cpu=sweeps)
     if spec.status == "unsupported":
         result["reason"] = spec.reason
     else:
@@ -385,17 +418,28 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
                                    flip_resampled=False) for n in (0, 1, 2)}
         if bounces(spec.technique):
             metrics["indirect"] = metric_set(min(1.0, flip * 1.8), w * h, bars, spec.nan_pixels)
+        if sweeps:  # newer runners: the direct-light layer vs. emission+direct
+            metrics["direct"] = metric_set(direct_layer_flip(spec), w * h, bars)
         if sweeps and spec.scene == "cornell_box":
             metrics["regions"] = {name: region_metrics(spec, flip * f, w * h // 6, bars)
                                   for name, f in zip(REGIONS, (0.8, 1.4))}
         ratio = {"direct": 0.0, "tech_a": 1.0 - 0.8 * flip, "tech_b": 1.0 - 0.5 * flip}
         metrics["energy_ratio"] = ratio[spec.technique]
         label = safe_label(spec.scene)
+        reference = {"key": hashlib.sha1((label + matched).encode()).hexdigest()[:16],
+                     "samples": 256, "rel_error": 0.01, "matched": matched,
+                     "final_png": f"../../references/{label}/{matched}.png",
+                     "final_exr": f"../../references/{label}/{matched}.exr"}
+        if sweeps:  # newer runners also record the full reference and the indirect layers
+            reference.update({
+                "full_png": f"../../references/{label}/{FULL}.png",
+                "full_exr": f"../../references/{label}/{FULL}.exr",
+                "indirect_png": f"../../references/{label}/{matched}.indirect.png",
+                "indirect_full_png": f"../../references/{label}/{FULL}.indirect.png"})
+        with open(os.path.join(folder, "output.exr"), "wb") as f:
+            f.write(EXR_MAGIC)
         result.update({
-            "reference": {"key": hashlib.sha1((label + matched).encode()).hexdigest()[:16],
-                          "samples": 256, "rel_error": 0.01, "matched": matched,
-                          "final_png": f"../../references/{label}/{matched}.png",
-                          "final_exr": f"../../references/{label}/{matched}.exr"},
+            "reference": reference,
             "timing": timing_json(spec, rng), "memory": memory_json(spec), "metrics": metrics,
             "nonfinite": {layer: {"nan_pixels": spec.nan_pixels if layer == "final" else 0,
                                   "inf_pixels": 0, "negative_pixels": 0}
@@ -407,15 +451,32 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
         json.dump(result, f, indent=2)
 
 
-def write_references(root: str) -> None:
+FULL = "full"
+FULL_BOUNCES = 3  # the fixture's "all light paths"
+
+
+def write_references(root: str, sweeps: bool) -> None:
+    """The bounce-matched references; with sweeps also the full one and the indirect layers
+    (reference minus emission+direct)."""
     for scene in SCENES:
-        for count, matched in MATCHED.items():
-            write_png(os.path.join(root, "references", safe_label(scene), f"{matched}.png"),
-                      reference_image(scene, count))
+        folder = os.path.join(root, "references", safe_label(scene))
+        direct = reference_image(scene, 0)
+        layers = dict(MATCHED.items())
+        if sweeps:
+            layers[FULL_BOUNCES] = FULL
+        for count, name in layers.items():
+            image = reference_image(scene, count)
+            write_png(os.path.join(folder, f"{name}.png"), image)
+            with open(os.path.join(folder, f"{name}.exr"), "wb") as f:
+                f.write(EXR_MAGIC)
+            if sweeps:
+                write_png(os.path.join(folder, f"{name}.indirect.png"),
+                          np.clip(image - direct, 0, 1))
 
 
-def write_extras(root: str, specs: list[Spec]) -> None:
-    """experiment.json, a malformed run folder and an in-progress one."""
+def write_extras(root: str, specs: list[Spec], sweeps: bool) -> None:
+    """experiment.json, a malformed run folder and an in-progress one. The flat fixture's
+    timer overhead is smaller than its IQR (the report must not quote it as a number)."""
     experiment = {"name": "fixture", "description": "Synthetic results for the report's tests: "
                   "two scenes, a baseline and two fake techniques.",
                   "config_path": "experiments/configs/fixture.json",
@@ -427,7 +488,8 @@ def write_extras(root: str, specs: list[Spec]) -> None:
                   "instrumentation": {"technique": "direct", "scene": "cornell_box",
                                       "frames_each": 8, "frame_cpu_ms_with_timestamps": 1.93,
                                       "frame_cpu_ms_without_timestamps": 1.88,
-                                      "overhead_ms": 0.05, "overhead_iqr_ms": 0.02}}
+                                      "overhead_ms": 0.05 if sweeps else 0.01,
+                                      "overhead_iqr_ms": 0.02}}
     with open(os.path.join(root, "experiment.json"), "w", encoding="utf-8") as f:
         json.dump(experiment, f, indent=2)
     broken = os.path.join(root, "runs", "0badc0ffee0badc0")
@@ -445,10 +507,10 @@ def write_fixture(root: str, sweeps: bool = True) -> list[Spec]:
     rng = np.random.default_rng(7)
     specs = run_specs(sweeps)
     os.makedirs(os.path.join(root, "runs"), exist_ok=True)
-    write_references(root)
+    write_references(root, sweeps)
     for spec in specs:
         write_run(root, spec, sweeps, rng)
-    write_extras(root, specs)
+    write_extras(root, specs, sweeps)
     return specs
 
 

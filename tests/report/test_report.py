@@ -23,10 +23,14 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import urllib.parse
 from dataclasses import dataclass, field
 from typing import Optional
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import page_checks  # noqa: E402
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
@@ -45,16 +49,19 @@ SECTIONS = ("images", "runs", "pareto", "sweeps", "passes", "equal", "skipped", 
 
 @dataclass
 class Checks:
+    """The results of one step (steps run in parallel threads; each prints when done)."""
+
     passed: int = 0
     failed: list[str] = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
 
     def check(self, ok: bool, what: str, detail: str = "") -> bool:
         if ok:
             self.passed += 1
-            print(f"  ok    {what}")
+            self.lines.append(f"  ok    {what}")
         else:
             self.failed.append(what)
-            print(f"  FAIL  {what}" + (f"\n        {detail}" if detail else ""))
+            self.lines.append(f"  FAIL  {what}" + (f"\n        {detail}" if detail else ""))
         return ok
 
 
@@ -107,7 +114,7 @@ def missing_links(page_path: str) -> list[str]:
 def chromium(tmp: str, url: str, extra: list[str]) -> subprocess.CompletedProcess:
     cmd = [CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu", "--no-first-run",
            "--enable-logging=stderr", "--v=0", "--virtual-time-budget=3000",
-           f"--user-data-dir={os.path.join(tmp, 'chromium-profile')}"] + extra + [url]
+           f"--user-data-dir={tempfile.mkdtemp(prefix='chromium-', dir=tmp)}"] + extra + [url]
     return run(cmd, timeout=60.0)
 
 
@@ -219,8 +226,23 @@ def check_main(checks: Checks, tmp: str) -> None:
     checks.check(any(s.startswith("sweep_tech_a_") for s in svgs)
                  and any(s.startswith("sweep_tech_b_") for s in svgs),
                  "sweep figures exist for tech_a and tech_b")
-    checks.check(not any(s.startswith("sweep_direct") for s in svgs),
-                 "no sweep figure for the technique without a sweep")
+    checks.check(not any(s.startswith("sweep_direct_sponza") for s in svgs),
+                 "no sweep figure for the parameter without effect")
+    first_titles = {s: next((t for t in page_checks.svg_texts(os.path.join(fixture, "figures", s))
+                             if t.startswith("HDR-FLIP vs")), "") for s in svgs
+                    if s.startswith(("pareto_", "sweep_"))}
+    checks.check(all(t == "HDR-FLIP vs full reference" for t in first_titles.values()),
+                 "the first panel of every error-vs-time and sweep figure is HDR-FLIP vs full "
+                 "reference", str({k: v for k, v in first_titles.items()
+                                   if v != "HDR-FLIP vs full reference"}))
+    page_checks.check_bases(checks, fixture, dom, "full")
+    page_checks.check_images(checks, fixture, dom)
+    page_checks.check_device(checks, fixture, dom, page_checks.LAVAPIPE)
+    page_checks.check_no_effect(checks, fixture, dom)
+    page_checks.check_exr_links(checks, fixture, dom)
+    page_checks.check_iqr_bars(checks, fixture)
+    page_checks.check_ties(checks, dom)
+    page_checks.check_overhead(checks, dom, measurable=True)
     checks.check("256^3 voxel grid needs 2.0 GiB" in dom, "the unsupported run's reason is shown")
     checks.check("0badc0ffee0badc0" in dom and "unreadable" in dom,
                  "the malformed run folder is listed as unreadable with its path")
@@ -252,11 +274,16 @@ def check_main(checks: Checks, tmp: str) -> None:
     checks.check(refs == {"cornell_box", "sponza_sun"}, "reference images of both scenes shown",
                  str(refs))
 
-    shot = os.path.join(tmp, "report.png")
+    screenshot(checks, tmp, page, "fixture page")
+
+
+def screenshot(checks: Checks, tmp: str, page: str, what: str) -> None:
+    """A 1400 x 3000 screenshot (kept with --keep, for looking at the layout)."""
+    shot = os.path.join(tmp, re.sub(r"\W+", "-", what) + ".png")
     result = chromium(tmp, "file://" + urllib.parse.quote(page),
                       [f"--screenshot={shot}", "--window-size=1400,3000", "--hide-scrollbars"])
     size = os.path.getsize(shot) if os.path.isfile(shot) else 0
-    checks.check(size > 10_000, f"screenshot is a non-trivial PNG ({size} bytes)",
+    checks.check(size > 10_000, f"{what}: screenshot is a non-trivial PNG ({size} bytes)",
                  result.stderr[-300:])
 
 
@@ -322,6 +349,12 @@ def check_no_sweeps(checks: Checks, tmp: str) -> None:
     checks.check(bool(flip_cells) and not any("±" in c for c in flip_cells),
                  "no-sweep fixture: no error bars on FLIP")
     checks.check(run_rows(items) == count_run_dirs(fixture), "no-sweep fixture: row count")
+    page_checks.check_bases(checks, fixture, dom, "matched")
+    page_checks.check_device(checks, fixture, dom, "GPU")
+    page_checks.check_overhead(checks, dom, measurable=False)
+    checks.check("the full reference image and the reference indirect layers are not recorded"
+                 in dom and "/full.png" not in dom,
+                 "no-sweep fixture (older runner): no full reference image, and the page says so")
 
 
 def check_merge(checks: Checks, tmp: str) -> None:
@@ -411,23 +444,42 @@ def main(argv: list[str]) -> int:
         return SKIP
     keep = "--keep" in argv
     tmp = tempfile.mkdtemp(prefix="gilab-report-test-")
-    checks = Checks()
     start = time.monotonic()
-    try:
-        for step in (check_detection, check_main, check_no_sweeps, check_merge, check_hostile,
-                     check_edges):
-            print(f"{step.__name__}:")
-            step(checks, tmp)
-    except Exception as e:  # a crash is a failure, with its message
-        checks.check(False, f"test ran without an exception: {type(e).__name__}: {e}")
-    finally:
-        if keep:
-            print(f"kept {tmp}")
-        else:
-            shutil.rmtree(tmp, ignore_errors=True)
+    # Chains in parallel threads (Chromium mostly waits): the merge needs the main fixture.
+    chains = [[check_main, check_merge], [check_no_sweeps],
+              [check_detection, check_hostile, check_edges]]
+    results: dict[str, Checks] = {}
+
+    def run_chain(steps: list) -> None:
+        for step in steps:
+            checks = results.setdefault(step.__name__, Checks())
+            began = time.monotonic()
+            try:
+                step(checks, tmp)
+            except Exception as e:  # a crash is a failure, with its message
+                checks.check(False, f"ran without an exception: {type(e).__name__}: {e}")
+            checks.lines.append(f"  ({time.monotonic() - began:.1f} s, ending at "
+                                f"{time.monotonic() - start:.1f} s)")
+
+    threads = [threading.Thread(target=run_chain, args=(chain,)) for chain in chains]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    passed, failed = 0, 0
+    for step in [s for chain in chains for s in chain]:
+        checks = results.get(step.__name__, Checks())
+        print(f"{step.__name__}:")
+        print("\n".join(checks.lines))
+        passed += checks.passed
+        failed += len(checks.failed)
+    if keep:
+        print(f"kept {tmp}")
+    else:
+        shutil.rmtree(tmp, ignore_errors=True)
     print(f"({time.monotonic() - start:.1f} s)")
-    print(f"{checks.passed} passed, {len(checks.failed)} failed")
-    return 0 if not checks.failed else 1
+    print(f"{passed} passed, {failed} failed")
+    return 0 if not failed else 1
 
 
 if __name__ == "__main__":

@@ -1,0 +1,102 @@
+"""Noise rules: when two runs can be told apart, and what a front or a trend may claim.
+
+A run's frame time is the interval [q1, q3] (its interquartile range over the timed frames; the
+median alone when the quartiles are missing); an error is [value − σ, value + σ] with σ the
+metric's error bar (1σ from the reference's noise; 0 when the metric has none). Two values are
+*separable* when their intervals do not overlap. A difference that is not separable is never
+called better, worse, a trend or a ranking: it is a tie (docs/report.md, "Noise").
+"""
+from __future__ import annotations
+
+from typing import Callable, Optional
+
+from report_data import Run
+
+Metric = Callable[[Run], Optional[float]]
+
+
+def time_interval(run: Run) -> tuple[float, float]:
+    """[q1, q3] of the frame time (the median where a quartile is missing)."""
+    median = run.frame_ms if run.frame_ms is not None else 0.0
+    lo = run.frame_q1 if run.frame_q1 is not None else median
+    hi = run.frame_q3 if run.frame_q3 is not None else median
+    return min(lo, median), max(hi, median)
+
+
+def value_interval(value: float, sigma: Optional[float]) -> tuple[float, float]:
+    s = abs(sigma) if sigma is not None else 0.0
+    return value - s, value + s
+
+
+def overlap(a: tuple[float, float], b: tuple[float, float]) -> bool:
+    return a[0] <= b[1] and b[0] <= a[1]
+
+
+def clearly_lower(a: float, a_sigma: Optional[float], b: float, b_sigma: Optional[float]
+                  ) -> bool:
+    """a < b beyond both error bars."""
+    return value_interval(a, a_sigma)[1] < value_interval(b, b_sigma)[0]
+
+
+def time_separable(a: Run, b: Run) -> bool:
+    return not overlap(time_interval(a), time_interval(b))
+
+
+def error_separable(a: Run, b: Run, error: Metric, sigma: Metric) -> bool:
+    ea, eb = error(a), error(b)
+    if ea is None or eb is None:
+        return True
+    return not overlap(value_interval(ea, sigma(a)), value_interval(eb, sigma(b)))
+
+
+def inseparable(a: Run, b: Run, error: Metric, sigma: Metric) -> bool:
+    """Neither frame time nor error tells the runs apart: a tie."""
+    return not time_separable(a, b) and not error_separable(a, b, error, sigma)
+
+
+def front_ties(points: list[Run], front: list[Run], error: Metric, sigma: Metric
+               ) -> dict[int, Run]:
+    """Runs off the front that are inseparable from a front run (id(run) -> that front run):
+    within the noise they are as good as the front, so the front marks them as ties."""
+    ties: dict[int, Run] = {}
+    on_front = {id(r) for r in front}
+    for run in points:
+        if id(run) in on_front:
+            continue
+        for member in front:
+            if inseparable(run, member, error, sigma):
+                ties[id(run)] = member
+                break
+    return ties
+
+
+def tied_best(best: Run, runs: list[Run], error: Metric, sigma: Metric) -> list[Run]:
+    """The other runs whose error cannot be told apart from the best one's."""
+    out = []
+    for run in runs:
+        if run is best or error(run) is None or error(best) is None:
+            continue
+        if not error_separable(run, best, error, sigma):
+            out.append(run)
+    return out
+
+
+def change_words(first: float, first_sigma: Optional[float], last: float,
+                 last_sigma: Optional[float], fmt: Callable[[float], str]) -> str:
+    """'falls from a to b' / 'rises from a to b' when separable, else 'no change beyond the
+    noise (a … b)'."""
+    if clearly_lower(last, last_sigma, first, first_sigma):
+        return f"falls from {fmt(first)} to {fmt(last)}"
+    if clearly_lower(first, first_sigma, last, last_sigma):
+        return f"rises from {fmt(first)} to {fmt(last)}"
+    return f"no change beyond the noise ({fmt(first)} … {fmt(last)})"
+
+
+def time_change_words(first: Run, last: Run, fmt: Callable[[float], str]) -> str:
+    """The frame-time change between two runs, in words, only when their IQRs separate."""
+    if first.frame_ms is None or last.frame_ms is None:
+        return "unknown"
+    if time_separable(first, last):
+        verb = "falls" if last.frame_ms < first.frame_ms else "rises"
+        return f"{verb} from {fmt(first.frame_ms)} to {fmt(last.frame_ms)} ms"
+    return f"no change beyond the IQR ({fmt(first.frame_ms)} … {fmt(last.frame_ms)} ms)"

@@ -1,0 +1,79 @@
+// Every experiment config shown in the documentation validates (issue 10): the ```json blocks
+// of README.md and docs/*.md that hold a "techniques" key, with the page's // comments removed,
+// parsed relative to experiments/configs/ (where the docs' relative scene paths point from).
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "core/util/error.h"
+#include "experiments/runner/experiment_config.h"
+
+namespace gilab {
+namespace {
+namespace fs = std::filesystem;
+
+struct Block {
+    std::string file;
+    int line = 0;
+    std::string text;
+};
+
+std::vector<Block> jsonBlocks(const fs::path& file) {
+    std::ifstream in(file);
+    std::vector<Block> blocks;
+    std::string line;
+    int n = 0;
+    bool inside = false;
+    while (std::getline(in, line)) {
+        ++n;
+        if (!inside && line.rfind("```json", 0) == 0) {
+            inside = true;
+            blocks.push_back({file.filename().string(), n + 1, ""});
+        } else if (inside && line.rfind("```", 0) == 0) {
+            inside = false;
+        } else if (inside) {
+            // Strip a // comment that is not inside a string (the docs never put // in strings).
+            const size_t c = line.find("//");
+            blocks.back().text += (c == std::string::npos ? line : line.substr(0, c)) + "\n";
+        }
+    }
+    return blocks;
+}
+
+TEST(CpuDocs, EveryConfigShownInTheDocsValidates) {
+    const fs::path root(GILAB_SOURCE_DIR);
+    std::vector<fs::path> pages{root / "README.md"};
+    for (const auto& e : fs::directory_iterator(root / "docs"))
+        if (e.path().extension() == ".md") pages.push_back(e.path());
+    int configs = 0;
+    for (const fs::path& page : pages) {
+        for (const Block& b : jsonBlocks(page)) {
+            nlohmann::json json;
+            try {
+                json = nlohmann::json::parse(b.text);
+            } catch (const std::exception& e) {
+                ADD_FAILURE() << b.file << ":" << b.line << ": not JSON: " << e.what();
+                continue;
+            }
+            if (!json.is_object() || !json.contains("techniques")) continue;
+            ++configs;
+            const std::string where = b.file + ":" + std::to_string(b.line);
+            try {
+                const exp::ExperimentConfig config = exp::parseExperimentConfig(
+                    json, where, (root / "experiments" / "configs").string());
+                EXPECT_FALSE(exp::expandRuns(config).empty()) << where;
+            } catch (const Error& e) {
+                ADD_FAILURE() << where << ": " << e.what();
+            }
+        }
+    }
+    EXPECT_GE(configs, 1) << "no config found in the docs: is the test still looking?";
+}
+
+}  // namespace
+}  // namespace gilab
