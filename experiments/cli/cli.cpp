@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/technique/registry.h"
 #include "core/util/atomic_file.h"
 #include "core/util/build_info.h"
 #include "core/util/error.h"
@@ -96,6 +97,21 @@ bool printSuggestion(const CLI::App& app, int argc, char** argv) {
 }
 
 }  // namespace
+
+void checkTechniqueName(const std::string& id) {
+    const TechniqueRegistry& registry = TechniqueRegistry::instance();
+    if (registry.find(id)) return;
+    std::vector<std::string> ids;
+    for (const TechniqueInfo* info : registry.list())
+        ids.push_back(info->id);
+    const std::string near = closestMatch(id, ids);
+    std::string known;
+    for (const std::string& k : ids)
+        known += (known.empty() ? "" : ", ") + k;
+    throw UsageError("unknown technique \"" + id + "\"" +
+                     (near.empty() ? "" : "; did you mean \"" + near + "\"?") +
+                     " (known: " + known + "; `gilab list` shows their parameters)");
+}
 
 std::string closestMatch(const std::string& word, const std::vector<std::string>& candidates) {
     std::string best;
@@ -329,10 +345,17 @@ int runMain(int argc, char** argv) {
         if (*list) return runList(listJson);
         if (*devices) return runDevices(deviceFilter);
         if (*info) return runSceneInfo(infoScene, infoJson);
-        if (*rend) return runRender(render);
+        if (*rend) {
+            checkTechniqueName(render.technique);
+            return runRender(render);
+        }
         if (*ref) return runReference(reference);
         if (*benchRefCmd) return runBenchReference(benchRef);
-        if (*benchTechCmd) return runBenchTechnique(benchTech);
+        if (*benchTechCmd) {
+            for (const std::string& t : benchTech.techniques)
+                checkTechniqueName(t);
+            return runBenchTechnique(benchTech);
+        }
         if (*runCmd) {
             if (!shard.empty()) {
                 try {

@@ -34,6 +34,9 @@ public:
 /** The closest of `candidates` to `word` (edit distance), or "" when none is close. */
 std::string closestMatch(const std::string& word, const std::vector<std::string>& candidates);
 
+/** Throws UsageError (with the closest registered id) when `id` is not a technique. */
+void checkTechniqueName(const std::string& id);
+
 /** The exit code of a run with this status ("ok", "nonfinite", "unsupported", "invalid"). */
 int exitCodeForStatus(const std::string& status);
 /** The exit code of `gilab run` after all its runs: interrupted, then invalid, then nonfinite. */
