@@ -307,9 +307,11 @@ void printDryRun(const std::vector<const RunSpec*>& runs, const std::vector<std:
         cells[row][column] = v.is_string() ? v.get<std::string>() : v.dump();
     };
     for (size_t i = 0; i < runs.size(); ++i) {
-        for (const auto& [k, v] : runs[i]->params.toOrderedJson().items())
+        const nlohmann::ordered_json params = runs[i]->params.toOrderedJson();
+        const nlohmann::ordered_json shared = runs[i]->shared.toOrderedJson();
+        for (const auto& [k, v] : params.items())
             add(i, "param." + k, v);
-        for (const auto& [k, v] : runs[i]->shared.toOrderedJson().items())
+        for (const auto& [k, v] : shared.items())
             add(i, "shared." + k, v);
     }
     std::printf("index\tkey\tstate\tscene\ttechnique");
