@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
+#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -180,6 +181,36 @@ TEST(CpuRunStore, RowsAreAppendedAndFlattened) {
     EXPECT_NE(lines[0].find("param.a"), std::string::npos) << lines[0];
     EXPECT_NE(lines[0].find("param.b"), std::string::npos) << lines[0];
     EXPECT_NE(lines[0].find("shared.area_light_samples"), std::string::npos) << lines[0];
+    fs::remove_all(dir);
+}
+
+TEST(CpuRunner, DryRunPrintsTheParameterColumnsOfTheResultTables) {
+    const fs::path dir = tempDir("dryrun");
+    nlohmann::json j = baseConfig();
+    j["techniques"].push_back(
+        {{"technique", "vct"}, {"sweep", {{"grid", {{"voxel_resolution", {32, 64}}}}}}});
+    const fs::path config = dir / "tiny.json";
+    std::ofstream(config) << j.dump(2);
+    RunnerOptions o;
+    o.configPath = config.string();
+    o.outRoot = (dir / "results").string();
+    o.dryRun = true;
+    testing::internal::CaptureStdout();
+    const RunnerSummary s = runExperiment(o, nullptr);
+    const std::string out = testing::internal::GetCapturedStdout();
+    EXPECT_EQ(s.total, 4u);
+    std::istringstream lines(out);
+    std::string header, line;
+    std::getline(lines, header);
+    for (const char* column : {"index", "key", "state", "technique", "shared.pcf_radius",
+                               "shared.area_light_samples", "param.voxel_resolution"})
+        EXPECT_NE(header.find(column), std::string::npos) << column << " in " << header;
+    int rows = 0;
+    while (std::getline(lines, line)) {
+        EXPECT_NE(line.find("[todo]"), std::string::npos) << line;
+        ++rows;
+    }
+    EXPECT_EQ(rows, 4);
     fs::remove_all(dir);
 }
 
