@@ -1,0 +1,17 @@
+#!/usr/bin/env bash
+# `cmake --install` gives a binary that works away from the build and source trees: it runs,
+# reports its version and finds the report code relative to itself (issue 10).
+set -euo pipefail
+build_dir="$1"
+tmp="$(mktemp -d)"
+trap 'rm -rf "$tmp"' EXIT
+cmake --install "$build_dir" --prefix "$tmp/prefix" >/dev/null
+mkdir -p "$tmp/work/results/empty/runs"
+cd "$tmp/work"
+"$tmp/prefix/bin/gilab" --version | grep -q '^gilab '
+# The report must come from the installed copy, not the source tree.
+out="$(GILAB_REPORT_SCRIPT= "$tmp/prefix/bin/gilab" report results/empty 2>&1)" || {
+    echo "$out"; exit 1; }
+test -f results/empty/report.html
+test -f "$tmp/prefix/share/gilab/report/make_report.py"
+echo "install ok: $tmp/prefix/bin/gilab"
