@@ -132,6 +132,28 @@ TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
     EXPECT_EQ(parseError(baseConfig()), "");
 }
 
+TEST(CpuExperimentConfig, ABlockCanBeLimitedToSomeScenes) {
+    nlohmann::json j = baseConfig();
+    j["scenes"] = {"builtin", std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot"};
+    j["techniques"].push_back(
+        {{"technique", "direct"},
+         {"scenes", {"builtin"}},
+         {"sweep", {{"grid", {{"shared.area_light_samples", {4, 16, 64}}}}}}});
+    const std::vector<RunSpec> runs = expandRuns(parseExperimentConfig(j, "cfg.json", "."));
+    ASSERT_EQ(runs.size(), 2u * 2u + 3u);  // pcf sweep on both scenes, samples on builtin only
+    int builtinSamples = 0;
+    for (const RunSpec& r : runs)
+        if (r.swept.count("shared.area_light_samples")) {
+            EXPECT_EQ(r.scene->label, "builtin");
+            ++builtinSamples;
+        }
+    EXPECT_EQ(builtinSamples, 3);
+    j["techniques"][1]["scenes"] = {"cornell_box#sopt"};
+    const std::string message = parseError(j);
+    EXPECT_NE(message.find("cornell_box#sopt"), std::string::npos) << message;
+    EXPECT_NE(message.find("cornell_box#spot"), std::string::npos) << message;
+}
+
 TEST(CpuExperimentConfig, ShardsParse) {
     EXPECT_EQ(parseShard("2/8"), std::make_pair(2, 8));
     EXPECT_THROW(parseShard("8/8"), Error);

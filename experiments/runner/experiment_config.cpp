@@ -1,5 +1,6 @@
 #include "experiments/runner/experiment_config.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -193,10 +194,25 @@ std::vector<std::pair<std::string, std::vector<nlohmann::json>>> parseAxes(const
     return axes;
 }
 
-TechniqueEntry parseTechnique(const JsonNode& node) {
-    node.expectKeys({"technique", "params", "sweep", "shared"});
+TechniqueEntry parseTechnique(const JsonNode& node, const std::set<std::string>& sceneLabels) {
+    node.expectKeys({"technique", "params", "sweep", "shared", "scenes"});
     TechniqueEntry t;
     t.id = node["technique"].string();
+    if (node.has("scenes")) {
+        // Only these scenes (labels as in "scenes"), e.g. a sweep that matters on one scene.
+        const JsonNode list = node["scenes"];
+        if (list.arraySize() == 0) list.fail("expected a non-empty list of scene labels");
+        for (size_t i = 0; i < list.arraySize(); ++i) {
+            const std::string label = list.item(i).string();
+            if (!sceneLabels.count(label)) {
+                std::string known;
+                for (const std::string& l : sceneLabels)
+                    known += (known.empty() ? "" : ", ") + l;
+                list.item(i).fail("no scene labelled \"" + label + "\" (scenes: " + known + ")");
+            }
+            t.scenes.push_back(label);
+        }
+    }
     ParamSet params;
     try {
         params = TechniqueRegistry::instance().defaultParams(t.id);
@@ -316,7 +332,7 @@ ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::st
     const JsonNode techniques = root["techniques"];
     if (techniques.arraySize() == 0) techniques.fail("needs at least one technique");
     for (size_t i = 0; i < techniques.arraySize(); ++i)
-        c.techniques.push_back(parseTechnique(techniques.item(i)));
+        c.techniques.push_back(parseTechnique(techniques.item(i), labels));
     expandRuns(c);  // validates every combination (shared limits included) before anything runs
     return c;
 }
@@ -338,6 +354,9 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
     std::vector<RunSpec> runs;
     for (const SceneEntry& scene : config.scenes) {
         for (const TechniqueEntry& t : config.techniques) {
+            if (!t.scenes.empty() &&
+                std::find(t.scenes.begin(), t.scenes.end(), scene.label) == t.scenes.end())
+                continue;
             ParamSet base = TechniqueRegistry::instance().defaultParams(t.id);
             for (const auto& [k, v] : t.fixed)
                 base.setJson(k, v);

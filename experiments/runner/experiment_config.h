@@ -57,6 +57,7 @@ struct TechniqueEntry {
     std::vector<std::pair<std::string, std::vector<nlohmann::json>>> grid;
     std::vector<std::pair<std::string, std::vector<nlohmann::json>>> zip;
     std::map<std::string, nlohmann::json> shared;  // shared-pass overrides for this technique
+    std::vector<std::string> scenes;  // scene labels this block runs on; empty = every scene
 };
 
 struct ExperimentConfig {
