@@ -19,7 +19,8 @@ namespace {
 static_assert(sizeof(Vertex) == 32, "Vertex changed: update hashVertices()");
 static_assert(sizeof(Camera) == 48, "Camera changed: update hashCamera()");
 static_assert(sizeof(RenderSettings) == 12, "RenderSettings changed: update the scene hash");
-static_assert(sizeof(Light) == sizeof(std::string) + 56, "Light changed: update hashLight()");
+// Light::color and ::strength are not hashed: renderers read intensity (== their product).
+static_assert(sizeof(Light) == sizeof(std::string) + 72, "Light changed: update hashLight()");
 static_assert(sizeof(Material) == sizeof(std::string) + 64,
               "Material changed: update hashMaterial()");
 static_assert(sizeof(Texture) == sizeof(std::string) + sizeof(std::vector<uint8_t>) + 24,

@@ -58,6 +58,7 @@ Light pointLight(glm::vec3 p, float intensity) {
     l.type = LightType::Point;
     l.position = p;
     l.intensity = glm::vec3(intensity);
+    l.color = l.intensity;
     return l;
 }
 
@@ -136,6 +137,7 @@ TEST_F(GpuDvsVoxel, NormalWeightedLambertOnDiagonalPlane) {
     sun.type = LightType::Directional;
     sun.direction = -glm::normalize(glm::vec3(1, 1, 0));
     sun.intensity = glm::vec3(1.0f);
+    sun.color = sun.intensity;
     s.lights.push_back(sun);
     const float rhoPi = kAlbedo / kPi;
     for (auto [lambert, factor] : {std::pair{DvsLambert::Cosine, 1.0f},
@@ -166,6 +168,7 @@ TEST_F(GpuDvsVoxel, ZeroLengthNormalIsIsotropicNotNaN) {
     sun.type = LightType::Directional;
     sun.direction = glm::vec3(-1, 0, 0);
     sun.intensity = glm::vec3(2.0f);
+    sun.color = sun.intensity;
     s.lights.push_back(sun);
     const std::vector<glm::vec4> v =
         lightVoxels(s, settingsWith(DvsVoxelShadows::Raycast, DvsLambert::NormalWeighted));

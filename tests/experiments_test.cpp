@@ -11,6 +11,9 @@
 #include <nlohmann/json.hpp>
 
 #include "core/util/error.h"
+#include "core/scene/animation.h"
+#include "core/scene/scene_loader.h"
+#include "reference/scene_hash.h"
 #include "experiments/runner/experiment_config.h"
 #include "experiments/runner/run_store.h"
 #include "experiments/runner/runner.h"
@@ -298,6 +301,69 @@ TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
     for (const auto& r : RunStore(a.dir).loadFinished())
         keys.insert(r["key"]);
     EXPECT_EQ(keys.size(), 2u);
+}
+
+TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {
+    nlohmann::json j = baseConfig();
+    j["name"] = "anim";
+    j["scenes"] = {
+        {{"scene", std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot_orbit"},
+         {"resolution", {16, 16}}}};
+    j["reference"]["frames"] = 4;  // frames 0, 4, 8 of 9
+    j["techniques"] = {{{"technique", "direct"}}};
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary s = runExperiment(options());
+    ASSERT_EQ(s.ran, 1u);
+    const auto finished = RunStore(s.dir).loadFinished();
+    ASSERT_EQ(finished.size(), 1u);
+    const nlohmann::json& r = finished[0];
+    EXPECT_EQ(r["status"], "ok");
+    EXPECT_EQ(r["animation"]["frames"], 9);
+    EXPECT_EQ(r["animation"]["measured_frames"], nlohmann::json({0, 4, 8}));
+    EXPECT_EQ(r["timing"]["dynamic_frames"], 8);  // frames 1..8, each after a move
+    EXPECT_TRUE(r["timing"]["dynamic_frame_cpu_ms"]["median"].is_number());
+    EXPECT_TRUE(r["timing"]["frame_cpu_ms"]["median"].is_number());  // the static frames
+    const auto& seq = r["metrics"]["sequence"];
+    ASSERT_EQ(seq["frames"].size(), 3u);
+    EXPECT_EQ(seq["frames"][1]["frame"], 4);
+    EXPECT_TRUE(seq["frames"][2]["final_vs_full"]["flip"]["mean"].is_number());
+    EXPECT_EQ(seq["temporal"]["pairs"], 2);
+    EXPECT_TRUE(seq["temporal"]["temporal_instability"].is_number());
+    const fs::path runDir = RunStore(s.dir).runDir(r["key"]);
+    for (const char* f : {"frames/000.png", "frames/004.png", "frames/008.png", "temporal.png"})
+        EXPECT_TRUE(fs::exists(runDir / f)) << f;
+    for (const auto& png : r["reference"]["frames_png"])
+        EXPECT_TRUE(fs::exists(runDir / png.get<std::string>())) << png;
+    // One cache entry per measured frame (frame 0 is also the static reference): the light
+    // moved, so the keys differ; the spot returns to its start, so frame 8 = frame 0.
+    size_t entries = 0;
+    for (const auto& e : fs::directory_iterator(m_dir / "cache"))
+        entries += e.is_directory() && e.path().filename().string()[0] != '.' ? 1 : 0;
+    // Distinct frames by their reference key (the spot returns to its start: frame 8 = 0).
+    auto distinctKeys = [&](std::initializer_list<int> frames) {
+        Scene scene = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json",
+                                    "spot_orbit");
+        scene.settings.width = scene.settings.height = 16;
+        const ExperimentConfig config = loadExperimentConfig(m_config);
+        std::set<std::string> keys;
+        for (int f : frames) {
+            Scene frame = scene;
+            applyFrameState(frame, frameState(scene, f));
+            keys.insert(ref::referenceKey(frame, config.reference.settings));
+        }
+        return keys.size();
+    };
+    EXPECT_EQ(entries, distinctKeys({0, 4, 8}));
+    EXPECT_EQ(entries, 2u);
+    // A second run with more frames measured renders only the frames not cached yet.
+    j["reference"]["frames"] = 2;
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary again = runExperiment(options());
+    EXPECT_EQ(again.ran, 1u);  // the run key hashes the measured frames' reference keys
+    entries = 0;
+    for (const auto& e : fs::directory_iterator(m_dir / "cache"))
+        entries += e.is_directory() && e.path().filename().string()[0] != '.' ? 1 : 0;
+    EXPECT_EQ(entries, distinctKeys({0, 2, 4, 6, 8}));  // 0 (= 8) and 4 reused
 }
 
 }  // namespace

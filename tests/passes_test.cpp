@@ -78,6 +78,7 @@ Light pointLight(glm::vec3 p, glm::vec3 intensity) {
     l.type = LightType::Point;
     l.position = p;
     l.intensity = intensity;
+    l.color = l.intensity;
     return l;
 }
 
@@ -315,6 +316,7 @@ TEST_F(GpuPassesTest, SpotLightFollowsConeFalloff) {
     light.position = {0.1f, 1.5f, 0.0f};
     light.direction = glm::normalize(glm::vec3(0.1f, -1.0f, 0.05f));
     light.intensity = {20.0f, 20.0f, 20.0f};
+    light.color = light.intensity;
     light.innerConeRad = 0.35f;
     light.outerConeRad = 0.6f;
     s.lights.push_back(light);
@@ -360,6 +362,7 @@ TEST_F(GpuPassesTest, DirectionalLightIsUniform) {
     light.type = LightType::Directional;
     light.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
     light.intensity = {2.0f, 3.0f, 4.0f};
+    light.color = light.intensity;
     s.lights.push_back(light);
     Frame f = render(s, topCamera());
 
@@ -538,6 +541,7 @@ TEST_F(GpuShadowTest, SpotLight2DMap) {
     l.position = {0.1f, 2.0f, 0.1f};
     l.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.0f));
     l.intensity = glm::vec3(8.0f);
+    l.color = l.intensity;
     l.innerConeRad = 0.5f;
     l.outerConeRad = 0.7f;
     runOccluder(l, "spot");
@@ -548,6 +552,7 @@ TEST_F(GpuShadowTest, DirectionalLightOrthoMap) {
     l.type = LightType::Directional;
     l.direction = glm::normalize(glm::vec3(-0.2f, -1.0f, 0.1f));
     l.intensity = glm::vec3(3.0f);
+    l.color = l.intensity;
     runOccluder(l, "directional");
 }
 
@@ -557,6 +562,7 @@ TEST_F(GpuShadowTest, WideSpotUsesCubeMap) {
     l.position = {0.05f, 2.0f, 0.0f};
     l.direction = glm::vec3(0.0f, -1.0f, 0.0f);
     l.intensity = glm::vec3(8.0f);
+    l.color = l.intensity;
     l.innerConeRad = 1.0f;
     l.outerConeRad = 1.5f;  // > 85 deg
     runOccluder(l, "wide spot");
@@ -703,6 +709,7 @@ Scene cornellWithPunctualLights() {
     spot.position = {0.278f, 0.54f, 0.28f};
     spot.direction = {0.0f, -1.0f, 0.0f};
     spot.intensity = glm::vec3(1.0f);
+    spot.color = spot.intensity;
     spot.innerConeRad = 0.9f;
     spot.outerConeRad = 1.2f;
     s.lights.push_back(spot);
@@ -711,6 +718,7 @@ Scene cornellWithPunctualLights() {
     sun.type = LightType::Directional;
     sun.direction = glm::normalize(glm::vec3(0.3f, -0.35f, 1.0f));
     sun.intensity = glm::vec3(0.3f);
+    sun.color = sun.intensity;
     s.lights.push_back(sun);
     s.computeCaps();
     return s;

@@ -79,6 +79,7 @@ Light pointLight(glm::vec3 p, glm::vec3 intensity) {
     l.type = LightType::Point;
     l.position = p;
     l.intensity = intensity;
+    l.color = l.intensity;
     return l;
 }
 
@@ -341,6 +342,7 @@ TEST(CpuReferencePunctual, SpotLightInnerFalloffAndOutside) {
     spot.position = {0.1f, 1.5f, 0.05f};
     spot.direction = glm::normalize(glm::vec3(0.1f, -1.0f, 0.0f));
     spot.intensity = glm::vec3(3.0f);
+    spot.color = spot.intensity;
     spot.innerConeRad = glm::radians(15.0f);
     spot.outerConeRad = glm::radians(30.0f);
     s.lights.push_back(spot);
@@ -389,6 +391,7 @@ TEST(CpuReferencePunctual, DirectionalLightIsUniform) {
     sun.type = LightType::Directional;
     sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.2f));
     sun.intensity = {1.0f, 2.0f, 3.0f};
+    sun.color = sun.intensity;
     s.lights.push_back(sun);
     const Accumulator acc = render(s, settingsWith(Estimator::Mis, 0), 4);
     const double cosTheta = -double(sun.direction.y);

@@ -146,6 +146,7 @@ TEST_F(GpuVctInjection, PlaneUnderDirectionalLightIsExactAtAnyTilt) {
         light.type = LightType::Directional;
         light.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.3f));
         light.intensity = glm::vec3(2.0f, 1.0f, 0.5f);
+        light.color = light.intensity;
         VctRig rig(*m_ctx, planeScene(plane, light), vctParams({}));
         const double cosTheta = -glm::dot(plane.n, light.direction);
         const Agreement a =
@@ -170,6 +171,7 @@ TEST_F(GpuVctInjection, PlaneUnderPointLightMatchesInverseSquare) {
         light.type = LightType::Point;
         light.position = 1.5f * plane.n;
         light.intensity = glm::vec3(3.0f, 2.0f, 1.0f);
+        light.color = light.intensity;
         VctRig rig(*m_ctx, planeScene(plane, light), vctParams({}));
         const Agreement a = compare(rig, plane, light.intensity, [&](glm::vec3 p) {
             const glm::dvec3 d = glm::dvec3(light.position) - glm::dvec3(p);
@@ -218,6 +220,7 @@ TEST(CpuVctInjection, AutoMapSizesFollowTheFootprintRuleAndTheBudget) {
         sun.type = LightType::Directional;
         sun.direction = glm::normalize(glm::vec3(0.3f, -1.0f, 0.1f));
         sun.intensity = glm::vec3(1.0f);
+        sun.color = sun.intensity;
         scene.lights.push_back(sun);
         const VoxelGrid grid(scene.caps.bounds, 64);
         const auto samples = buildEmitterSamples(scene, 16);

@@ -974,6 +974,7 @@ TEST_F(GpuVctSvoInjection, PlaneUnderDirectionalLightIsExactAtAnyTilt) {
         light.type = LightType::Directional;
         light.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.3f));
         light.intensity = glm::vec3(2.0f, 1.0f, 0.5f);
+        light.color = light.intensity;
         const double cosTheta = -glm::dot(plane.n, light.direction);
         const PlaneAgreement a =
             run(plane, {light}, [&](glm::vec3) { return glm::dvec3(light.intensity) * cosTheta; });
@@ -996,6 +997,7 @@ TEST_F(GpuVctSvoInjection, FixedPointAccumulatorsGiveTheSameIrradiance) {
     light.type = LightType::Directional;
     light.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.3f));
     light.intensity = glm::vec3(2.0f, 1.0f, 0.5f);
+    light.color = light.intensity;
     const double cosTheta = -glm::dot(plane.n, light.direction);
     const PlaneAgreement a =
         run(plane, {light}, [&](glm::vec3) { return glm::dvec3(light.intensity) * cosTheta; });
@@ -1018,6 +1020,7 @@ TEST_F(GpuVctSvoInjection, PointAndTwoLightsMatchTheAnalyticIrradiance) {
         point.type = LightType::Point;
         point.position = 1.5f * plane.n;
         point.intensity = glm::vec3(3.0f, 2.0f, 1.0f);
+        point.color = point.intensity;
         const PlaneAgreement a = run(plane, {point}, [&](glm::vec3 p) {
             const glm::dvec3 d = glm::dvec3(point.position) - glm::dvec3(p);
             const double r = glm::length(d);
@@ -1033,8 +1036,10 @@ TEST_F(GpuVctSvoInjection, PointAndTwoLightsMatchTheAnalyticIrradiance) {
         sun1.type = sun2.type = LightType::Directional;
         sun1.direction = glm::normalize(glm::vec3(0.2f, -1.0f, 0.3f));
         sun1.intensity = glm::vec3(2.0f, 1.0f, 0.5f);
+        sun1.color = sun1.intensity;
         sun2.direction = glm::normalize(glm::vec3(-0.6f, -1.0f, -0.2f));
         sun2.intensity = glm::vec3(0.5f, 1.0f, 2.0f);
+        sun2.color = sun2.intensity;
         const PlaneAgreement b = run(plane, {sun1, sun2}, [&](glm::vec3) {
             return glm::dvec3(sun1.intensity) * double(-glm::dot(plane.n, sun1.direction)) +
                    glm::dvec3(sun2.intensity) * double(-glm::dot(plane.n, sun2.direction));

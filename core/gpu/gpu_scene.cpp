@@ -162,6 +162,21 @@ void GpuScene::setLightShadowIndices(const std::vector<int>& shadowIndices) {
     m_lights.uploadVector(m_gpuLights);
 }
 
+void GpuScene::updateLights(const std::vector<uint32_t>& changed) {
+    if (m_scene->lights.size() != m_gpuLights.size())
+        throw Error("updateLights: the scene has " + std::to_string(m_scene->lights.size()) +
+                    " lights, the GPU scene " + std::to_string(m_gpuLights.size()));
+    for (uint32_t i : changed) {
+        if (i >= m_gpuLights.size())
+            throw Error("updateLights: light " + std::to_string(i) + " of " +
+                        std::to_string(m_gpuLights.size()));
+        const float shadowIndex = m_gpuLights[i].cone.z;
+        m_gpuLights[i] = toGpuLight(m_scene->lights[i]);
+        m_gpuLights[i].cone.z = shadowIndex;
+    }
+    if (!changed.empty()) m_lights.uploadVector(m_gpuLights);
+}
+
 void GpuScene::bindGeometry(VkCommandBuffer cmd) const {
     VkBuffer vertexBuffer = m_vertices.handle();
     VkDeviceSize offset = 0;

@@ -123,6 +123,11 @@ public:
     void setLightShadowIndex(uint32_t light, int shadowIndex);
     /** Same for several lights at once (one upload); size must equal lightCount(). */
     void setLightShadowIndices(const std::vector<int>& shadowIndices);
+    /**
+     * Re-packs lights `changed` from scene().lights (an animated scene moved them; same count
+     * and types) and re-uploads the buffer; each light keeps its shadow index (cone.z).
+     */
+    void updateLights(const std::vector<uint32_t>& changed);
 
     const DescriptorSetLayout& layout() const { return m_layout; }
     const DescriptorSet& set() const { return m_set; }

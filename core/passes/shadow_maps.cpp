@@ -90,73 +90,92 @@ ShadowMaps::ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettin
     m_pipeline = vk::GraphicsPipeline(ctx, desc, m_layout);
 }
 
+ShadowMaps::Frame ShadowMaps::sceneFrame() const {
+    const Scene& scene = m_scene.scene();
+    const Bounds& b = scene.caps.bounds;
+    Frame f;
+    f.center = b.valid() ? b.center() : glm::vec3(0.0f);
+    f.radius = b.valid() ? std::max(0.5f * glm::length(b.extent()), 1e-3f) : 1.0f;
+    f.nearZ = 1e-3f * f.radius;
+    return f;
+}
+
+void ShadowMaps::addCubeJobs(const PassLight& light, uint32_t lightIndex, ShadowKind kind,
+                             uint32_t cube, const Job::Push& base, float nearZ,
+                             std::vector<Job>& jobs) const {
+    for (int face = 0; face < 6; ++face) {
+        Job job{kind, cube * 6 + uint32_t(face), lightIndex, base};
+        const CubeFace& f = kCubeFaces[face];
+        job.push.viewProj =
+            pinholeViewProj(glm::vec3(light.positionType), f.m, f.s, f.t, 1.0f, nearZ);
+        job.push.origin = glm::vec4(glm::vec3(light.positionType), 0.0f);
+        jobs.push_back(job);
+    }
+}
+
+PassLight ShadowMaps::sceneLightEntry(const Light& l, uint32_t index, ShadowKind kind,
+                                      uint32_t slot, std::vector<Job>& jobs) const {
+    const Frame frame = sceneFrame();
+    const float res = float(m_settings.resolution);
+    PassLight light;
+    light.positionType = glm::vec4(l.position, 0.0f);
+    light.direction = glm::vec4(glm::normalize(l.direction), 0.0f);
+    light.intensity = glm::vec4(l.intensity, 0.0f);
+    light.cone = glm::vec4(std::cos(l.innerConeRad), std::cos(l.outerConeRad), 0.0f, 0.0f);
+    light.bias = glm::vec4(m_settings.constantBias, m_settings.slopeBias, m_settings.normalOffset,
+                           float(m_settings.pcfRadius));
+    const glm::vec3 dir(light.direction);
+    light.positionType.w = float(l.type == LightType::Point  ? kPassLightPoint
+                                 : l.type == LightType::Spot ? kPassLightSpot
+                                                             : kPassLightDirectional);
+    if (kind == kShadowCube) {
+        light.shadow = glm::vec4(float(kShadowCube), float(slot), 2.0f / res, 0.0f);
+        addCubeJobs(light, index, kShadowCube, slot, Job::Push{}, frame.nearZ, jobs);
+    } else if (kind == kShadowMap2D && l.type == LightType::Spot) {
+        const float fov = std::min(2.0f * l.outerConeRad + kSpotMarginRad, kMaxSpotFovRad);
+        light.viewProj = spotViewProj(l.position, dir, fov, frame.nearZ);
+        light.shadow =
+            glm::vec4(float(kShadowMap2D), float(slot), 2.0f * std::tan(0.5f * fov) / res, 0.0f);
+        Job job{kShadowMap2D, slot, index, {}};
+        job.push.viewProj = light.viewProj;
+        job.push.origin = glm::vec4(l.position, 0.0f);
+        jobs.push_back(job);
+    } else if (kind == kShadowMap2D) {  // directional: orthographic over the bounding sphere
+        const float r = 1.02f * frame.radius + 1e-4f;
+        const glm::vec3 origin = frame.center - dir * r;
+        light.origin = glm::vec4(origin, 1.0f);
+        light.viewProj = orthoViewProj(origin, dir, r);
+        light.shadow = glm::vec4(float(kShadowMap2D), float(slot), 2.0f * r / res, 1.0f);
+        Job job{kShadowMap2D, slot, index, {}};
+        job.push.viewProj = light.viewProj;
+        job.push.origin = glm::vec4(origin, 1.0f);
+        job.push.direction = glm::vec4(dir, 0.0f);
+        jobs.push_back(job);
+    }
+    return light;
+}
+
 void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLightSamples) {
     const Scene& scene = gpuScene.scene();
     const bool shadows = m_settings.enabled;
-    const Bounds& b = scene.caps.bounds;
-    const glm::vec3 center = b.valid() ? b.center() : glm::vec3(0.0f);
-    const float radius = b.valid() ? std::max(0.5f * glm::length(b.extent()), 1e-3f) : 1.0f;
-    const float nearZ = 1e-3f * radius;
-    const float res = float(m_settings.resolution);
+    const Frame frame = sceneFrame();
     const glm::vec4 bias(m_settings.constantBias, m_settings.slopeBias, m_settings.normalOffset,
                          float(m_settings.pcfRadius));
 
-    auto addCube = [&](PassLight& light, ShadowKind kind, uint32_t& counter, const Job::Push& base,
-                       float texelFactor) {
-        light.shadow = glm::vec4(float(kind), float(counter), texelFactor, 0.0f);
-        for (int face = 0; face < 6; ++face) {
-            Job job{kind, counter * 6 + uint32_t(face), base};
-            const CubeFace& f = kCubeFaces[face];
-            job.push.viewProj =
-                pinholeViewProj(glm::vec3(light.positionType), f.m, f.s, f.t, 1.0f, nearZ);
-            job.push.origin = glm::vec4(glm::vec3(light.positionType), 0.0f);
-            m_jobs.push_back(job);
+    for (uint32_t i = 0; i < uint32_t(scene.lights.size()); ++i) {
+        const Light& l = scene.lights[i];
+        // Each light's map slot is fixed here; an animated light keeps it (updateSceneLights).
+        ShadowKind kind = kShadowNone;
+        uint32_t slot = 0;
+        if (shadows && (l.type == LightType::Point ||
+                        (l.type == LightType::Spot && l.outerConeRad > kCubeSpotOuterRad))) {
+            kind = kShadowCube;
+            slot = m_cubeCount++;
+        } else if (shadows) {
+            kind = kShadowMap2D;
+            slot = m_layers2D++;
         }
-        ++counter;
-    };
-
-    for (const Light& l : scene.lights) {
-        PassLight light;
-        light.positionType = glm::vec4(l.position, 0.0f);
-        light.direction = glm::vec4(glm::normalize(l.direction), 0.0f);
-        light.intensity = glm::vec4(l.intensity, 0.0f);
-        light.cone = glm::vec4(std::cos(l.innerConeRad), std::cos(l.outerConeRad), 0.0f, 0.0f);
-        light.bias = bias;
-        const glm::vec3 dir(light.direction);
-        if (l.type == LightType::Point) {
-            light.positionType.w = float(kPassLightPoint);
-            if (shadows) addCube(light, kShadowCube, m_cubeCount, Job::Push{}, 2.0f / res);
-        } else if (l.type == LightType::Spot) {
-            light.positionType.w = float(kPassLightSpot);
-            if (shadows && l.outerConeRad > kCubeSpotOuterRad) {
-                addCube(light, kShadowCube, m_cubeCount, Job::Push{}, 2.0f / res);
-            } else if (shadows) {
-                float fov = std::min(2.0f * l.outerConeRad + kSpotMarginRad, kMaxSpotFovRad);
-                light.viewProj = spotViewProj(l.position, dir, fov, nearZ);
-                light.shadow = glm::vec4(float(kShadowMap2D), float(m_layers2D),
-                                         2.0f * std::tan(0.5f * fov) / res, 0.0f);
-                Job job{kShadowMap2D, m_layers2D++, {}};
-                job.push.viewProj = light.viewProj;
-                job.push.origin = glm::vec4(l.position, 0.0f);
-                m_jobs.push_back(job);
-            }
-        } else {
-            light.positionType.w = float(kPassLightDirectional);
-            if (shadows) {
-                const float r = 1.02f * radius + 1e-4f;
-                const glm::vec3 origin = center - dir * r;
-                light.origin = glm::vec4(origin, 1.0f);
-                light.viewProj = orthoViewProj(origin, dir, r);
-                light.shadow =
-                    glm::vec4(float(kShadowMap2D), float(m_layers2D), 2.0f * r / res, 1.0f);
-                Job job{kShadowMap2D, m_layers2D++, {}};
-                job.push.viewProj = light.viewProj;
-                job.push.origin = glm::vec4(origin, 1.0f);
-                job.push.direction = glm::vec4(dir, 0.0f);
-                m_jobs.push_back(job);
-            }
-        }
-        m_lights.push_back(light);
+        m_lights.push_back(sceneLightEntry(l, i, kind, slot, m_jobs));
     }
     m_sceneLightCount = uint32_t(m_lights.size());
 
@@ -172,8 +191,12 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
         if (shadows) {
             Job::Push skip;
             skip.skipPlane = glm::vec4(s.normal, glm::dot(s.normal, s.position));
-            skip.params.x = 1e-4f * radius;
-            addCube(light, kShadowAreaCube, m_areaCubeCount, skip, 2.0f / areaRes);
+            skip.params.x = 1e-4f * frame.radius;
+            light.shadow =
+                glm::vec4(float(kShadowAreaCube), float(m_areaCubeCount), 2.0f / areaRes, 0.0f);
+            addCubeJobs(light, uint32_t(m_lights.size()), kShadowAreaCube, m_areaCubeCount, skip,
+                        frame.nearZ, m_jobs);
+            ++m_areaCubeCount;
         }
         m_lights.push_back(light);
     }
@@ -251,8 +274,30 @@ void ShadowMaps::createImages() {
     });
 }
 
-void ShadowMaps::record(VkCommandBuffer cmd) {
+void ShadowMaps::updateSceneLights(const std::vector<uint32_t>& changed) {
+    const Scene& scene = m_scene.scene();
+    for (uint32_t i : changed) {
+        if (i >= m_sceneLightCount || i >= scene.lights.size())
+            throw Error("ShadowMaps::updateSceneLights: light " + std::to_string(i) + " of " +
+                        std::to_string(m_sceneLightCount));
+        const PassLight& old = m_lights[i];
+        std::vector<Job> jobs;
+        m_lights[i] = sceneLightEntry(scene.lights[i], i, ShadowKind(uint32_t(old.shadow.x)),
+                                      uint32_t(old.shadow.y), jobs);
+        size_t k = 0;  // same light type, same slot: its jobs are replaced in place
+        for (Job& job : m_jobs)
+            if (job.light == i && k < jobs.size()) job = jobs[k++];
+    }
+    if (!changed.empty()) m_lightBuffer.uploadVector(m_lights);
+}
+
+void ShadowMaps::record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights) {
     if (m_jobs.empty() || m_scene.triangleCount() == 0) return;
+    auto wanted = [&](const Job& job) {
+        return !onlyLights ||
+               std::find(onlyLights->begin(), onlyLights->end(), job.light) != onlyLights->end();
+    };
+    if (std::none_of(m_jobs.begin(), m_jobs.end(), wanted)) return;
     for (vk::Image* image : {&m_maps2D, &m_cubes, &m_areaCubes}) {
         image->transition(cmd, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
     }
@@ -261,6 +306,7 @@ void ShadowMaps::record(VkCommandBuffer cmd) {
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_layout.handle(), 0, 1, &set, 0,
                             nullptr);
     for (const Job& job : m_jobs) {
+        if (!wanted(job)) continue;
         // The shared depth buffer: full barrier between renders (write after write)
         m_depth.transition(cmd, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
         vk::Image& target = job.kind == kShadowMap2D  ? m_maps2D

@@ -35,6 +35,8 @@
 
 namespace gilab {
 
+struct Light;
+
 namespace vk {
 class Context;
 class GpuScene;
@@ -68,8 +70,17 @@ public:
     ShadowMaps(const ShadowMaps&) = delete;
     ShadowMaps& operator=(const ShadowMaps&) = delete;
 
-    /** Renders every map (one draw of the scene per 2D map or cube face). */
-    void record(VkCommandBuffer cmd);
+    /**
+     * Renders every map (one draw of the scene per 2D map or cube face), or only the maps of
+     * the pass lights in `onlyLights` (an animated scene re-renders the lights that moved).
+     */
+    void record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights = nullptr);
+    /**
+     * Recomputes the table entries and map matrices of scene lights `changed` from the
+     * GpuScene's scene (same count and types; each keeps its map slot) and re-uploads the
+     * table. Their maps are stale until record(cmd, &changed).
+     */
+    void updateSceneLights(const std::vector<uint32_t>& changed);
 
     const std::vector<PassLight>& lights() const { return m_lights; }
     uint32_t lightCount() const { return uint32_t(m_lights.size()); }
@@ -97,6 +108,7 @@ private:
     struct Job {
         ShadowKind kind = kShadowNone;
         uint32_t layer = 0;  // layer of the target image (6 * cube + face for cubes)
+        uint32_t light = 0;  // index into lights()
         struct Push {
             glm::mat4 viewProj{1.0f};
             glm::vec4 origin{0.0f};  // w 1 = orthographic
@@ -107,6 +119,19 @@ private:
     };
     static_assert(sizeof(Job::Push) == 128);
 
+    /** Scene bounds the directional maps are fitted to, and the near plane. */
+    struct Frame {
+        glm::vec3 center{0.0f};
+        float radius = 1.0f;
+        float nearZ = 1e-3f;
+    };
+    Frame sceneFrame() const;
+    /** The table entry of scene light `l` (index `index`) with its map in `slot` of `kind`
+     *  (kShadowNone: no map), appending its render jobs to `jobs`. */
+    PassLight sceneLightEntry(const Light& l, uint32_t index, ShadowKind kind, uint32_t slot,
+                              std::vector<Job>& jobs) const;
+    void addCubeJobs(const PassLight& light, uint32_t lightIndex, ShadowKind kind, uint32_t cube,
+                     const Job::Push& base, float nearZ, std::vector<Job>& jobs) const;
     void buildLightTable(const vk::GpuScene& scene, uint32_t areaLightSamples);
     void createImages();
 

@@ -24,6 +24,20 @@ void SharedPasses::recordShadows(VkCommandBuffer cmd, vk::GpuTimer* timer) {
     m_shadowsValid = true;
 }
 
+void SharedPasses::updateLights(const std::vector<uint32_t>& changed) {
+    if (changed.empty()) return;
+    m_shadows->updateSceneLights(changed);
+    m_staleLights.insert(m_staleLights.end(), changed.begin(), changed.end());
+}
+
+void SharedPasses::recordShadowUpdates(VkCommandBuffer cmd, vk::GpuTimer* timer) {
+    if (m_staleLights.empty()) return;
+    std::optional<vk::ScopedGpuPass> scope;
+    if (timer) scope.emplace(*timer, cmd, "shadow_maps.update");
+    m_shadows->record(cmd, &m_staleLights);
+    m_staleLights.clear();
+}
+
 void SharedPasses::record(VkCommandBuffer cmd, const Camera& camera, vk::GpuTimer* timer) {
     {
         std::optional<vk::ScopedGpuPass> scope;

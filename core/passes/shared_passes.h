@@ -4,10 +4,11 @@
  *   gbuffer -> shadow_maps -> direct_light
  * each wrapped in a vk::ScopedGpuPass of that name when a timer is given.
  *
- * Shadow-map policy: scenes and lights are static, so the maps are rendered once and reused.
+ * Shadow-map policy: the maps are rendered once and reused while lights are static.
  * recordShadows() renders them (the harness calls it during setup so their cost is reported once,
  * as setup time); record() renders them only while they are not valid yet (first frame without a
- * setup call) or after invalidateShadows(). Nothing else invalidates them.
+ * setup call) or after invalidateShadows(). An animated light (updateLights) gets its own map,
+ * and only its map, re-rendered by recordShadowUpdates() in the next dynamic frame.
  */
 #include <cstdint>
 #include <memory>
@@ -46,6 +47,14 @@ public:
     /** One frame: G-buffer, shadow maps if not valid, direct light. */
     void record(VkCommandBuffer cmd, const Camera& camera, vk::GpuTimer* timer = nullptr);
     void invalidateShadows() { m_shadowsValid = false; }
+    /**
+     * Scene lights `changed` moved (the GpuScene's scene holds their new data and the GpuScene
+     * light buffer is updated): updates the pass light table now; their shadow maps, and only
+     * theirs, are re-rendered by the next recordShadowUpdates().
+     */
+    void updateLights(const std::vector<uint32_t>& changed);
+    /** Re-renders the maps of the lights given to updateLights() (pass "shadow_maps.update"). */
+    void recordShadowUpdates(VkCommandBuffer cmd, vk::GpuTimer* timer = nullptr);
     bool shadowsValid() const { return m_shadowsValid; }
 
     GBufferPass& gbufferPass() { return *m_gbuffer; }
@@ -69,6 +78,7 @@ private:
     std::unique_ptr<ShadowMaps> m_shadows;
     std::unique_ptr<DirectLightPass> m_direct;
     bool m_shadowsValid = false;
+    std::vector<uint32_t> m_staleLights;  // scene lights whose maps await recordShadowUpdates
 };
 
 }  // namespace gilab

@@ -214,7 +214,9 @@ private:
         const glm::vec3 color = src.color.size() == 3
                                     ? glm::vec3(src.color[0], src.color[1], src.color[2])
                                     : glm::vec3(1.0f);
-        light.intensity = float(src.intensity) * color;
+        light.color = color;
+        light.strength = float(src.intensity);
+        light.intensity = light.color * light.strength;
         if (!std::isfinite(src.intensity) || src.intensity < 0.0 ||
             glm::any(glm::lessThan(color, glm::vec3(0.0f)))) {
             throw Error(what + " has a negative or non-finite intensity/color");

@@ -14,6 +14,7 @@
 
 #include <glm/glm.hpp>
 
+#include "core/scene/animation.h"
 #include "core/scene/camera.h"
 
 namespace gilab {
@@ -83,6 +84,9 @@ enum class LightType { Point, Spot, Directional };
  * A punctual light (KHR_lights_punctual semantics, radiometric units).
  *  - Point / Spot: `intensity` is radiant intensity in W/sr per RGB channel.
  *  - Directional: `intensity` is irradiance in W/m^2 on a surface facing the light.
+ * `intensity` is what every renderer reads; it always equals `color * strength` (the
+ * description's "color" and "intensity", kept apart so an animation can change one of them).
+ * Code that only knows the product sets color = intensity, strength = 1.
  * Spot falloff between the outer and inner cone follows the glTF recommendation (conventions.md).
  */
 struct Light {
@@ -91,7 +95,9 @@ struct Light {
     glm::vec3 position{0.0f};
     glm::vec3 direction{0.0f, -1.0f,
                         0.0f};  // unit; the direction light travels (spot, directional)
-    glm::vec3 intensity{1.0f};
+    glm::vec3 intensity{1.0f};  // == color * strength
+    glm::vec3 color{1.0f};      // linear RGB, each >= 0
+    float strength = 1.0f;      // >= 0
     float innerConeRad = 0.0f;  // spot only
     float outerConeRad = 0.7853982f;
     float range = 0.0f;  // 0 = infinite. Stored for completeness; no technique windows by range.
@@ -130,6 +136,7 @@ struct Scene {
     std::vector<Light> lights;
     Camera camera;
     RenderSettings settings;
+    SceneAnimation animation;  // empty = static (docs/scenes.md "Animation")
 
     SceneCaps caps;
     std::vector<std::string> warnings;     // e.g. "dropped 12 degenerate triangles"

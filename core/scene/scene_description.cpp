@@ -1,5 +1,6 @@
 #include "core/scene/scene_description.h"
 
+#include <cmath>
 #include <filesystem>
 
 #include <glm/gtc/constants.hpp>
@@ -73,7 +74,203 @@ std::vector<Light> parseLights(const JsonNode& node) {
     return lights;
 }
 
+struct AnimationTarget {
+    AnimationProperty property = AnimationProperty::LightPosition;
+    std::string lightName;
+};
+
+AnimationTarget parseAnimationTarget(const JsonNode& node) {
+    const std::string t = node.string();
+    const char* kForms =
+        "light:<name>.position|direction|intensity|color, camera.position|target|vfov_deg";
+    AnimationTarget target;
+    if (t.rfind("node:", 0) == 0) {
+        node.fail("\"" + t + "\": rigid node transforms are not supported yet (animate lights " +
+                  "and the camera: " + kForms + ")");
+    }
+    if (t.rfind("camera.", 0) == 0) {
+        const std::string prop = t.substr(7);
+        if (prop == "position")
+            target.property = AnimationProperty::CameraPosition;
+        else if (prop == "target")
+            target.property = AnimationProperty::CameraTarget;
+        else if (prop == "vfov_deg")
+            target.property = AnimationProperty::CameraFov;
+        else
+            node.fail("unknown camera property \"" + prop + "\" (position, target, vfov_deg)");
+        return target;
+    }
+    if (t.rfind("light:", 0) == 0) {
+        const size_t dot = t.rfind('.');
+        if (dot == std::string::npos || dot <= 6) {
+            node.fail("\"" + t + "\": expected \"light:<name>.<property>\"");
+        }
+        target.lightName = t.substr(6, dot - 6);
+        const std::string prop = t.substr(dot + 1);
+        if (prop == "position")
+            target.property = AnimationProperty::LightPosition;
+        else if (prop == "direction")
+            target.property = AnimationProperty::LightDirection;
+        else if (prop == "intensity")
+            target.property = AnimationProperty::LightIntensity;
+        else if (prop == "color")
+            target.property = AnimationProperty::LightColor;
+        else
+            node.fail("unknown light property \"" + prop +
+                      "\" (position, direction, intensity, color)");
+        return target;
+    }
+    node.fail("unknown target \"" + t + "\" (expected " + kForms + ")");
+}
+
+/** One key's value, checked for the property (float-finite, ranges; directions normalised). */
+glm::vec3 parseKeyValue(const JsonNode& node, AnimationProperty property) {
+    if (animationPropertyIsScalar(property)) {
+        double v = 0.0;
+        if (property == AnimationProperty::LightIntensity) {
+            v = node.numberIn(0.0, 1e12);
+        } else {
+            v = node.number();
+            if (!(v > 0.0 && v < 180.0)) {
+                node.fail("out of range: a field of view must be in (0, 180) degrees (got " +
+                          node.raw().dump() + ")");
+            }
+        }
+        return glm::vec3(float(v), 0.0f, 0.0f);
+    }
+    glm::vec3 v = property == AnimationProperty::LightColor ? node.color(1e12) : node.vec3();
+    if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) {
+        node.fail("value out of the float range");
+    }
+    if (property == AnimationProperty::LightDirection) {
+        const float len = glm::length(v);
+        if (!(len > 1e-6f) || !std::isfinite(len)) node.fail("zero-length direction");
+        v /= len;
+    }
+    return v;
+}
+
 }  // namespace
+
+AnimationDescription parseAnimation(const JsonNode& node) {
+    node.expectKeys({"duration_s", "frames", "tracks"});
+    AnimationDescription out;
+    SceneAnimation& a = out.animation;
+    a.frameCount = node["frames"].integerIn(1, 10000);
+    a.duration = node["duration_s"].numberIn(0.0, 1e9);
+    if (!(a.duration > 0.0) && a.frameCount != 1) {
+        node["duration_s"].fail("must be > 0 (0 only with \"frames\": 1)");
+    }
+    const JsonNode tracks = node["tracks"];
+    if (tracks.arraySize() == 0) tracks.fail("expected at least one track");
+    for (size_t i = 0; i < tracks.arraySize(); ++i) {
+        const JsonNode t = tracks.item(i);
+        t.expectKeys({"target", "interpolation", "keys"});
+        AnimationTrack track;
+        const AnimationTarget target = parseAnimationTarget(t["target"]);
+        track.property = target.property;
+        track.lightName = target.lightName;
+        const bool direction = track.property == AnimationProperty::LightDirection;
+        track.interpolation = direction ? Interpolation::Slerp : Interpolation::Linear;
+        if (t.has("interpolation")) {
+            const JsonNode mode = t["interpolation"];
+            const std::string name = mode.string();
+            if (name == "linear") {
+                track.interpolation = Interpolation::Linear;
+            } else if (name == "slerp") {
+                if (!direction) mode.fail("slerp applies to direction tracks only (use linear)");
+                track.interpolation = Interpolation::Slerp;
+            } else {
+                mode.fail("unknown interpolation \"" + name + "\" (linear, slerp)");
+            }
+        }
+        const JsonNode keys = t["keys"];
+        if (keys.arraySize() == 0) keys.fail("expected at least one key [time, value]");
+        for (size_t k = 0; k < keys.arraySize(); ++k) {
+            const JsonNode key = keys.item(k);
+            if (key.arraySize() != 2) key.fail("expected [time, value]");
+            AnimationKey parsed;
+            parsed.time = key.item(0).number();
+            if (k > 0 && !(parsed.time > track.keys.back().time)) {
+                key.item(0).fail("key times must increase strictly (got " +
+                                 key.item(0).raw().dump() + " after " +
+                                 keys.item(k - 1).item(0).raw().dump() + ")");
+            }
+            parsed.value = parseKeyValue(key.item(1), track.property);
+            track.keys.push_back(parsed);
+        }
+        const std::string name = animationTarget(track);
+        for (size_t j = 0; j < a.tracks.size(); ++j) {
+            if (animationTarget(a.tracks[j]) == name) {
+                t["target"].fail("a second track for \"" + name + "\" (" + out.trackPaths[j] +
+                                 " animates it already)");
+            }
+        }
+        a.tracks.push_back(std::move(track));
+        out.trackPaths.push_back(t.path());
+    }
+    return out;
+}
+
+SceneAnimation resolveAnimation(const SceneDescription& d, const Scene& scene) {
+    if (!d.animation) return SceneAnimation{};
+    SceneAnimation a = d.animation->animation;
+    bool cameraTracks = false;
+    for (size_t i = 0; i < a.tracks.size(); ++i) {
+        AnimationTrack& track = a.tracks[i];
+        const std::string where = d.context + ": \"" + d.animation->trackPaths[i] + ".target\": ";
+        const AnimationProperty p = track.property;
+        if (p == AnimationProperty::CameraPosition || p == AnimationProperty::CameraTarget ||
+            p == AnimationProperty::CameraFov) {
+            cameraTracks = true;
+            continue;
+        }
+        std::vector<uint32_t> matches;
+        std::string names;
+        for (size_t l = 0; l < scene.lights.size(); ++l) {
+            if (scene.lights[l].name == track.lightName) matches.push_back(uint32_t(l));
+            names += (names.empty() ? "" : ", ") + scene.lights[l].name;
+        }
+        if (matches.empty()) {
+            throw Error(where + "unknown light \"" + track.lightName + "\" (" +
+                        (names.empty() ? "the scene has no lights" : "the scene has: " + names) +
+                        ")");
+        }
+        if (matches.size() > 1) {
+            throw Error(where + std::to_string(matches.size()) + " lights are named \"" +
+                        track.lightName + "\"; give them distinct names");
+        }
+        const Light& light = scene.lights[matches[0]];
+        if (p == AnimationProperty::LightDirection && light.type == LightType::Point) {
+            throw Error(where + "light \"" + light.name +
+                        "\" is a point light: it has no direction");
+        }
+        if (p == AnimationProperty::LightPosition && light.type == LightType::Directional) {
+            throw Error(where + "light \"" + light.name +
+                        "\" is a directional light: its position is not used");
+        }
+        track.lightIndex = matches[0];
+    }
+    if (cameraTracks) {
+        // Every frame's camera must be usable (a moving position may meet a moving target).
+        Scene probe;
+        probe.lights = scene.lights;
+        probe.camera = scene.camera;
+        probe.animation = a;
+        for (int f = 0; f < a.frameCount; ++f) {
+            const Camera c = frameState(probe, f).camera;
+            const std::string where = d.context + ": \"animation\": frame " + std::to_string(f) +
+                                      " (t = " + std::to_string(a.frameTime(f)) + " s): ";
+            const glm::vec3 forward = c.target - c.position;
+            if (!(glm::length(forward) > 1e-6f))
+                throw Error(where + "camera position equals target");
+            if (!(glm::length(glm::cross(glm::normalize(forward), c.up)) > 1e-4f)) {
+                throw Error(where + "camera up is parallel to the viewing direction");
+            }
+        }
+    }
+    return a;
+}
 
 Light parseLight(const JsonNode& node) {
     node.expectKeys({"type", "name", "position", "direction", "target", "color", "intensity",
@@ -107,7 +304,9 @@ Light parseLight(const JsonNode& node) {
     // Radiometric: intensity x color = W/sr (point, spot) or W/m^2 (directional)
     const glm::vec3 color = node.has("color") ? node["color"].color() : glm::vec3(1.0f);
     const double intensity = node["intensity"].numberIn(0.0, 1e12);
-    light.intensity = color * float(intensity);
+    light.color = color;
+    light.strength = float(intensity);
+    light.intensity = light.color * light.strength;
     if (node.has("range")) light.range = float(node["range"].numberIn(0.0, 1e12));
 
     if (light.type == LightType::Spot) {
@@ -133,7 +332,7 @@ Light parseLight(const JsonNode& node) {
 
 SceneDescription parseSceneDescription(const JsonNode& root, const std::string& baseDir) {
     root.expectKeys({"name", "gltf", "procedural", "camera", "resolution", "exposure_ev", "lights",
-                     "extra_lights", "material_overrides", "remove_emissive"});
+                     "extra_lights", "material_overrides", "remove_emissive", "animation"});
     SceneDescription d;
     d.context = root.context();
     if (root.has("name")) {
@@ -177,6 +376,7 @@ SceneDescription parseSceneDescription(const JsonNode& root, const std::string& 
         }
     }
     d.removeEmissive = booleanOr(root, "remove_emissive", false);
+    if (root.has("animation")) d.animation = parseAnimation(root["animation"]);
     return d;
 }
 

@@ -37,6 +37,13 @@ struct MaterialOverride {
     std::optional<glm::vec3> emissive;
 };
 
+/** "animation" as parsed: light tracks name their light; indices are resolved by
+ *  resolveAnimation once the scene's lights are final. */
+struct AnimationDescription {
+    SceneAnimation animation;
+    std::vector<std::string> trackPaths;  // "animation.tracks[i]" per track, for messages
+};
+
 struct SceneDescription {
     std::string context;  // "scenes/x.json" or `scenes/x.json (variant "spot")`, for messages
     std::optional<std::string> name;
@@ -49,6 +56,7 @@ struct SceneDescription {
     std::vector<Light> extraLights;            // appended
     std::vector<MaterialOverride> materialOverrides;
     bool removeEmissive = false;
+    std::optional<AnimationDescription> animation;
 };
 
 /**
@@ -59,5 +67,15 @@ SceneDescription parseSceneDescription(const JsonNode& root, const std::string& 
 
 /** Parses one light object of "lights" / "extra_lights". */
 Light parseLight(const JsonNode& node);
+
+/** Parses an "animation" block (docs/scenes.md "Animation"); light indices stay unresolved. */
+AnimationDescription parseAnimation(const JsonNode& node);
+
+/**
+ * The description's animation resolved against the built scene: light names become indices
+ * into `scene.lights` (an unknown name lists the scene's lights), each light track must suit its
+ * light's type, and the camera of every frame must stay valid. Empty without an animation.
+ */
+SceneAnimation resolveAnimation(const SceneDescription& d, const Scene& scene);
 
 }  // namespace gilab

@@ -115,6 +115,9 @@ Scene buildScene(const SceneDescription& d) {
         scene.settings.height = d.resolution->y;
     }
     if (d.exposureEv) scene.settings.exposureEv = *d.exposureEv;
+    scene.animation = resolveAnimation(d, scene);  // the lights and camera are final
+    // A loaded scene shows frame 0 (tracks own what they animate, so later frames are unaffected)
+    if (scene.animation.animated()) applyFrameState(scene, frameState(scene, 0));
     return scene;
 }
 
@@ -181,6 +184,8 @@ Scene loadSceneFile(const std::string& pathWithVariant, const std::string& varia
             JsonNode(item.value(), path, "variants." + item.key()).fail("expected an object");
         }
         nlohmann::json merged = doc;
+        // A variant's "animation" replaces the base's as a whole (no key-by-key merge)
+        if (item.value().contains("animation")) merged.erase("animation");
         merged.merge_patch(item.value());  // RFC 7386: objects merge, null deletes a key
         descriptions.emplace(item.key(), parseSceneDescription(JsonNode(merged, context), baseDir));
     }

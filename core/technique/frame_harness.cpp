@@ -1,5 +1,6 @@
 #include "core/technique/frame_harness.h"
 
+#include <algorithm>
 #include <map>
 
 #include "core/gpu/gpu_scene.h"
@@ -123,6 +124,22 @@ SetupTiming FrameHarness::setup() {
     return t;
 }
 
+SceneChanges FrameHarness::setFrameState(const SceneFrameState& state) {
+    if (state.lights.size() != m_scene.lights.size())
+        throw Error("setFrameState: " + std::to_string(state.lights.size()) +
+                    " lights for a scene with " + std::to_string(m_scene.lights.size()));
+    const SceneChanges changes =
+        diffFrameStates(SceneFrameState{m_scene.lights, m_scene.camera}, state);
+    applyFrameState(m_scene, state);
+    for (uint32_t i : changes.lights)
+        if (std::find(m_pending.lights.begin(), m_pending.lights.end(), i) ==
+            m_pending.lights.end())
+            m_pending.lights.push_back(i);
+    m_pending.camera = m_pending.camera || changes.camera;
+    m_pending.geometry = m_pending.geometry || changes.geometry;
+    return m_pending;
+}
+
 FrameTiming FrameHarness::renderFrame() {
     if (!m_ready) throw Error("FrameHarness::renderFrame() called before setup()");
     FrameTiming t;
@@ -130,6 +147,32 @@ FrameTiming FrameHarness::renderFrame() {
     TechniqueContext ctx = makeContext();
     vk::GpuTimer* timer = m_timestamps ? m_timer.get() : nullptr;
     ctx.timer = timer;
+    if (m_pending.any()) {
+        // The dynamic part: shared state first (lights buffer, pass light table), then the
+        // technique's update (its own timed submissions), all inside this frame's time.
+        t.dynamic = true;
+        Stopwatch update;
+        if (!m_pending.lights.empty()) {
+            m_gpuScene->updateLights(m_pending.lights);
+            m_shared->updateLights(m_pending.lights);
+            m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
+                if (timer) timer->reset(cmd);
+                m_shared->recordShadowUpdates(cmd, timer);
+            });
+            if (timer)
+                for (const vk::PassTime& p : timer->resolve())
+                    t.updatePasses.push_back(p);
+        }
+        m_setupTimes.clear();
+        TechniqueContext uctx = makeContext();
+        uctx.timer = timer;  // submitTimed resets and resolves it per submission
+        t.update = m_technique->update(uctx, m_pending);
+        for (const PassTimeRecord& p : m_setupTimes)
+            t.updatePasses.push_back({p.name, p.gpuMs, 0.0});
+        m_setupTimes.clear();
+        t.updateCpuMs = update.elapsedMs();
+        m_pending = SceneChanges{};
+    }
     m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
         if (timer) timer->reset(cmd);
         m_shared->record(cmd, m_scene.camera, timer);

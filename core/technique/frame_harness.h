@@ -14,6 +14,8 @@
 
 #include "core/image/image.h"
 #include "core/params/params.h"
+#include "core/scene/animation.h"
+#include "core/scene/scene.h"
 #include "core/technique/technique.h"
 #include "core/vk/timer.h"
 
@@ -36,8 +38,14 @@ struct SetupTiming {
 };
 
 struct FrameTiming {
-    double cpuMs = 0.0;  // record + submit + wait, CPU wall time
+    double cpuMs = 0.0;  // record + submit + wait, CPU wall time (update work included)
     std::vector<vk::PassTime> passes;
+    // A dynamic frame (lights, camera or geometry changed since the previous frame) also runs
+    // the update: GpuScene light upload, pass light table, the technique's update().
+    bool dynamic = false;
+    UpdateKind update = UpdateKind::None;
+    double updateCpuMs = 0.0;                // CPU wall time of the update before the frame
+    std::vector<vk::PassTime> updatePasses;  // GPU times of the technique's update submissions
 };
 
 /** Bytes of device memory by owner: "scene", "shared", the technique id, ... */
@@ -62,7 +70,15 @@ public:
 
     /** Throws gilab::Error if the technique does not support the scene. */
     SetupTiming setup();
+    /**
+     * Moves the scene to `state` (lights, camera: a frame of its animation). The changes are
+     * applied by the next renderFrame(), which is then a dynamic frame. Returns what changed
+     * (accumulated with changes not rendered yet).
+     */
+    SceneChanges setFrameState(const SceneFrameState& state);
     FrameTiming renderFrame();
+    /** The scene as it is now (the harness's own copy; animated frames change it). */
+    const Scene& scene() const { return m_scene; }
     /** Frames without timestamp queries (to measure the instrumentation's own cost). */
     void setTimestampsEnabled(bool enabled) { m_timestamps = enabled; }
     /** Changes technique parameters between frames; calls onParamsChanged with changed keys. */
@@ -79,7 +95,8 @@ private:
     TechniqueContext makeContext();
 
     vk::Context& m_ctx;
-    const Scene& m_scene;
+    Scene m_scene;  // own copy: setFrameState moves its lights and camera
+    SceneChanges m_pending;
     std::unique_ptr<Technique> m_technique;
     ParamSet m_params;
     ParamSet m_sharedParams;

@@ -1,5 +1,7 @@
 #include "core/technique/technique.h"
 
+#include "core/scene/animation.h"
+
 #include "core/scene/scene.h"
 #include "core/vk/context.h"
 #include "core/vk/timer.h"
@@ -57,6 +59,24 @@ SupportResult Technique::checkSupport(const Scene& scene, const ParamSet&) const
 
 void Technique::onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys) {
     if (ctx.params.changesNeedRebuild(keys)) setup(ctx);
+}
+
+UpdateKind Technique::update(TechniqueContext& ctx, const SceneChanges& changes) {
+    if (!changes.any()) return UpdateKind::None;
+    setup(ctx);
+    return UpdateKind::FullRebuild;
+}
+
+const char* updateKindName(UpdateKind kind) {
+    switch (kind) {
+        case UpdateKind::None:
+            return "none";
+        case UpdateKind::Incremental:
+            return "incremental";
+        case UpdateKind::FullRebuild:
+            return "full rebuild";
+    }
+    return "?";
 }
 
 }  // namespace gilab

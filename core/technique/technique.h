@@ -11,6 +11,9 @@
  *   checkSupport()    can it run on this scene? If not, the harness skips it with the reason
  *   setup()           precomputation (voxelization, clustering, ...), timed apart from frames
  *   onParamsChanged() only the keys that changed; the default re-runs setup() for Rebuild keys
+ *   update()          lights, camera or geometry changed (an animated scene): do what the paper
+ *                     does on such a change as named, timed passes; the default re-runs setup()
+ *                     and is reported as a "full rebuild"
  *   render()          records the per-frame passes into the frame's command buffer; it must write
  *                     the indirect layer (linear HDR radiance, RGBA32F) and may add debug views
  * The harness owns the shared passes (G-buffer, shadow maps, direct light), the composition
@@ -28,6 +31,7 @@
 namespace gilab {
 
 struct Scene;
+struct SceneChanges;
 
 class SharedPasses;
 struct GBuffer;
@@ -125,6 +129,14 @@ private:
     VkCommandBuffer m_cmd;
 };
 
+/** What a technique did about a scene change (Technique::update), recorded per frame. */
+enum class UpdateKind {
+    None,         // nothing to redo (e.g. only the camera moved and nothing depends on it)
+    Incremental,  // the technique's own update passes (what its paper does on a change)
+    FullRebuild,  // set-up re-run: the technique has no real update path
+};
+const char* updateKindName(UpdateKind kind);  // "none", "incremental", "full rebuild"
+
 /** The images of one frame. `indirect` is cleared to zero before render() is called. */
 struct FrameTargets {
     vk::Image& indirect;  // RGBA32F storage image, GENERAL layout: write indirect radiance here
@@ -140,6 +152,16 @@ public:
     virtual void setup(TechniqueContext& ctx) = 0;
     /** Default: runs setup() again when any changed key has stage Rebuild. */
     virtual void onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys);
+    /**
+     * Called before a frame when lights, camera or geometry changed since the previous frame.
+     * ctx.scene already holds the new state, and the shared passes are updated (the GpuScene
+     * light buffer and pass light table now; the moved lights' shadow maps are re-rendered at
+     * the start of this frame, before render(), so update work that reads them belongs in
+     * render() or in submissions made after ctx.shared.recordShadowUpdates()). Record update
+     * passes with ctx.submitTimed + PassScope (their GPU times count as this frame's update).
+     * Default: setup() again when anything changed (FullRebuild), else None.
+     */
+    virtual UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes);
     /** Records the frame's passes. Must not submit; the harness submits and waits. */
     virtual void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) = 0;
     virtual std::vector<DebugView> debugViews() { return {}; }

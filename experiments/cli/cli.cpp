@@ -219,6 +219,9 @@ int runMain(int argc, char** argv) {
         ->check(CLI::Range(1u, 65536u))
         ->capture_default_str();
     ref->add_option("--resolution", reference.resolution, "Override the scene resolution, WxH");
+    ref->add_option("--frames", reference.frames,
+                    "Animated scenes: render these frames (all, every:K, or 0,4,8), each cached "
+                    "under its own key, into <out>/frame_NNN/");
     CLI::Option* cacheOpt = ref->add_option(
         "--cache", reference.cacheDir,
         "Reference cache folder (default: $GILAB_CACHE/reference, else results/cache/reference; "

@@ -91,6 +91,7 @@ struct ReferenceOptions {
     std::string pixelFilter = "box";  // "box" | "center"
     uint64_t seed = 1;
     uint32_t batchSamples = 4;
+    std::string frames;      // animated scenes: "all", "every:K", "0,4,8"; "" = static
     std::string resolution;  // "WxH", "" = the scene's
     std::string cacheDir;    // "" = $GILAB_REFERENCE_CACHE or results/cache/reference
     bool noCache = false;

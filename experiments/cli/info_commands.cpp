@@ -43,6 +43,14 @@ int runSceneInfo(const std::string& scenePath, bool json) {
     std::printf("  features: %s\n", info["caps"]["features"].dump().c_str());
     std::printf("  resolution %dx%d, exposure %+g EV\n", scene.settings.width,
                 scene.settings.height, scene.settings.exposureEv);
+    if (scene.animation.animated()) {
+        const SceneAnimation& a = scene.animation;
+        std::string targets;
+        for (const AnimationTrack& t : a.tracks)
+            targets += (targets.empty() ? "" : ", ") + animationTarget(t);
+        std::printf("  animation: %d frames over %g s, %zu track%s (%s)\n", a.frameCount,
+                    a.duration, a.tracks.size(), a.tracks.size() == 1 ? "" : "s", targets.c_str());
+    }
     for (const std::string& w : scene.warnings)
         std::printf("  warning: %s\n", w.c_str());
     return kExitOk;

@@ -1,6 +1,8 @@
 // `gilab reference`: the path-traced ground truth of one scene, through the reference cache ->
 // <out>/reference.exr (mean + stderr layers), reference.png, reference.json [, convergence.csv]
 #include <unistd.h>
+#include <algorithm>
+#include <charconv>
 
 #include <cstdio>
 #include <filesystem>
@@ -8,11 +10,13 @@
 #include <optional>
 
 #include "core/image/image_io.h"
+#include "core/scene/animation.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/interrupt.h"
 #include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_sequence.h"
 #include "reference/cache.h"
 
 namespace gilab::cli {
@@ -77,13 +81,9 @@ std::string cacheSummary(const ref::ReferenceResult& r, bool cacheUsed) {
 
 }  // namespace
 
-int runReference(const ReferenceOptions& options) {
-    Progress::setQuiet(options.quiet);
-    Scene scene = loadSceneOrDefault(options.scenePath);
-    applyResolutionOverride(scene, options.resolution);
-    for (const std::string& w : scene.warnings)
-        std::fprintf(stderr, "gilab: %s: warning: %s\n", scene.name.c_str(), w.c_str());
-
+/** The reference of one (static or frame) scene into `outDirPath`. */
+int renderReference(const ReferenceOptions& options, const Scene& scene,
+                    const std::string& outDirPath) {
     ref::ReferenceSettings settings;
     settings.maxBounces = options.maxBounces;
     settings.rouletteStartBounce = options.rouletteDepth;
@@ -130,7 +130,7 @@ int runReference(const ReferenceOptions& options) {
 
     // Outputs: EXR (mean + stderr), PNG (full, scene exposure), JSON, convergence curve
     const bool cancelled = r.reason == ref::StopReason::Cancelled;
-    const std::filesystem::path outDir(options.outDir);
+    const std::filesystem::path outDir(outDirPath);
     std::filesystem::create_directories(outDir);
     const std::string base = (outDir / "reference").string();
     std::vector<ImageLayer> layers;
@@ -207,6 +207,66 @@ int runReference(const ReferenceOptions& options) {
         return kExitNonFinite;
     }
     return kExitOk;
+}
+
+/** "all", "every:K" (or "K"), or a comma list "0,4,8": frames of an N-frame animation. */
+std::vector<int> parseFrameSelection(const std::string& text, int frameCount) {
+    std::vector<int> frames;
+    auto bad = [&]() {
+        return UsageError("--frames \"" + text +
+                          "\": expected all, every:K, K (every K-th frame) or a list like 0,4,8 "
+                          "(the animation has frames 0.." +
+                          std::to_string(frameCount - 1) + ")");
+    };
+    auto toInt = [&](const std::string& t) {
+        int v = -1;
+        const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (ec != std::errc() || ptr != t.data() + t.size()) throw bad();
+        return v;
+    };
+    if (text == "all") return exp::measuredFrames(frameCount, 1);
+    if (text.rfind("every:", 0) == 0 || text.find(',') == std::string::npos) {
+        const int k = toInt(text.rfind("every:", 0) == 0 ? text.substr(6) : text);
+        if (k < 1) throw bad();
+        return exp::measuredFrames(frameCount, k);
+    }
+    size_t start = 0;
+    while (start <= text.size()) {
+        const size_t comma = text.find(',', start);
+        const int f = toInt(text.substr(start, comma - start));
+        if (f < 0 || f >= frameCount) throw bad();
+        frames.push_back(f);
+        if (comma == std::string::npos) break;
+        start = comma + 1;
+    }
+    return frames;
+}
+
+int runReference(const ReferenceOptions& options) {
+    Progress::setQuiet(options.quiet);
+    Scene scene = loadSceneOrDefault(options.scenePath);
+    applyResolutionOverride(scene, options.resolution);
+    for (const std::string& w : scene.warnings)
+        std::fprintf(stderr, "gilab: %s: warning: %s\n", scene.name.c_str(), w.c_str());
+    if (options.frames.empty()) return renderReference(options, scene, options.outDir);
+    if (!scene.animation.animated())
+        throw UsageError("--frames: " + scene.name + " has no animation (docs/scenes.md)");
+    // One reference per selected frame, each cached under its own key (the frame's lights
+    // and camera are part of it): re-running renders only what is missing.
+    int worst = kExitOk;
+    for (int f : parseFrameSelection(options.frames, scene.animation.frameCount)) {
+        Scene frameScene = scene;
+        applyFrameState(frameScene, frameState(scene, f));
+        char dir[32];
+        std::snprintf(dir, sizeof dir, "frame_%03d", f);
+        std::printf("frame %d of %d (t = %.3f s):\n", f, scene.animation.frameCount,
+                    scene.animation.frameTime(f));
+        const int code = renderReference(options, frameScene,
+                                         (std::filesystem::path(options.outDir) / dir).string());
+        if (code == kExitInterrupted) return code;
+        worst = std::max(worst, code);
+    }
+    return worst;
 }
 
 }  // namespace gilab::cli

@@ -127,26 +127,47 @@ nlohmann::ordered_json sceneToJson(const Scene& scene) {
                           {"inner_cone_rad", l.innerConeRad},
                           {"outer_cone_rad", l.outerConeRad}});
     }
-    return {{"name", scene.name},
-            {"source", scene.sourcePath},
-            {"files", scene.loadedFiles},
-            {"resolution", {scene.settings.width, scene.settings.height}},
-            {"exposure_ev", scene.settings.exposureEv},
-            {"camera",
-             {{"position", vec3Json(scene.camera.position)},
-              {"target", vec3Json(scene.camera.target)},
-              {"up", vec3Json(scene.camera.up)},
-              {"vfov_deg", scene.camera.vfovRad * 180.0 / M_PI}}},
-            {"lights", lights},
-            {"caps",
-             {{"triangles", c.triangleCount},
-              {"emissive_triangles", c.emissiveTriangleCount},
-              {"materials", scene.materials.size()},
-              {"textures", scene.textures.size()},
-              {"features", features},
-              {"bounds_min", vec3Json(c.bounds.lo)},
-              {"bounds_max", vec3Json(c.bounds.hi)}}},
-            {"warnings", scene.warnings}};
+    nlohmann::ordered_json out = {{"name", scene.name},
+                                  {"source", scene.sourcePath},
+                                  {"files", scene.loadedFiles},
+                                  {"resolution", {scene.settings.width, scene.settings.height}},
+                                  {"exposure_ev", scene.settings.exposureEv},
+                                  {"camera",
+                                   {{"position", vec3Json(scene.camera.position)},
+                                    {"target", vec3Json(scene.camera.target)},
+                                    {"up", vec3Json(scene.camera.up)},
+                                    {"vfov_deg", scene.camera.vfovRad * 180.0 / M_PI}}},
+                                  {"lights", lights},
+                                  {"caps",
+                                   {{"triangles", c.triangleCount},
+                                    {"emissive_triangles", c.emissiveTriangleCount},
+                                    {"materials", scene.materials.size()},
+                                    {"textures", scene.textures.size()},
+                                    {"features", features},
+                                    {"bounds_min", vec3Json(c.bounds.lo)},
+                                    {"bounds_max", vec3Json(c.bounds.hi)}}},
+                                  {"warnings", scene.warnings}};
+    // Only animated scenes get the key, so static scenes describe (and identify) as before.
+    if (scene.animation.animated()) {
+        const SceneAnimation& a = scene.animation;
+        nlohmann::ordered_json tracks = nlohmann::ordered_json::array();
+        for (const AnimationTrack& t : a.tracks) {
+            nlohmann::ordered_json keys = nlohmann::ordered_json::array();
+            for (const AnimationKey& k : t.keys) {
+                if (animationPropertyIsScalar(t.property))
+                    keys.push_back({k.time, k.value.x});
+                else
+                    keys.push_back({k.time, vec3Json(k.value)});
+            }
+            tracks.push_back(
+                {{"target", animationTarget(t)},
+                 {"interpolation", t.interpolation == Interpolation::Slerp ? "slerp" : "linear"},
+                 {"keys", keys}});
+        }
+        out["animation"] = {
+            {"frames", a.frameCount}, {"duration_s", a.duration}, {"tracks", tracks}};
+    }
+    return out;
 }
 
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
@@ -188,6 +209,38 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
             {"frame_cpu_ms", summaryJson(cpu)},
             {"frame_gpu_ms", summaryJson(gpuTotal)},
             {"passes", passes}};
+}
+
+nlohmann::ordered_json dynamicTimingJson(const std::vector<FrameTiming>& frames) {
+    std::vector<double> cpu, gpu, update;
+    std::vector<std::string> order;
+    std::map<std::string, std::vector<double>> passes;
+    for (const FrameTiming& f : frames) {
+        if (!f.dynamic) continue;
+        cpu.push_back(f.cpuMs);
+        update.push_back(f.updateCpuMs);
+        double total = 0.0;
+        for (const std::vector<vk::PassTime>* list : {&f.passes, &f.updatePasses})
+            for (const vk::PassTime& p : *list)
+                total += p.gpuMs;
+        gpu.push_back(total);
+        // Update passes may repeat a name (one submission per light): summed per frame.
+        std::map<std::string, double> perFrame;
+        for (const vk::PassTime& p : f.updatePasses) {
+            if (!perFrame.count(p.name) && !passes.count(p.name)) order.push_back(p.name);
+            perFrame[p.name] += p.gpuMs;
+        }
+        for (const auto& [name, ms] : perFrame)
+            passes[name].push_back(ms);
+    }
+    nlohmann::ordered_json list = nlohmann::ordered_json::array();
+    for (const std::string& name : order)
+        list.push_back({{"name", name}, {"gpu_ms", summaryJson(passes[name])}});
+    return {{"dynamic_frames", cpu.size()},
+            {"dynamic_frame_cpu_ms", summaryJson(cpu)},
+            {"dynamic_frame_gpu_ms", summaryJson(gpu)},
+            {"update_cpu_ms", summaryJson(update)},
+            {"update_passes", list}};
 }
 
 nlohmann::ordered_json memoryJson(const MemoryReport& memory) {

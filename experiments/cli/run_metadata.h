@@ -24,6 +24,12 @@ nlohmann::ordered_json sceneToJson(const Scene& scene);
 /** Setup times, then per-frame CPU and per-pass GPU times as median / IQR over the frames. */
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
                                   int warmupFrames);
+/**
+ * The dynamic frames (FrameTiming::dynamic) of an animated run: frame CPU time (update
+ * included), frame GPU time (frame passes + update passes), update CPU time, and each update
+ * pass's GPU time, as median / IQR (docs/timing.md "Dynamic frames").
+ */
+nlohmann::ordered_json dynamicTimingJson(const std::vector<FrameTiming>& frames);
 nlohmann::ordered_json memoryJson(const MemoryReport& memory);
 /**
  * The Vulkan validation messages captured since the last call (or since the context was made):

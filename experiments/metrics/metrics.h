@@ -8,6 +8,7 @@
  *   PSNR (HDR)             linear, peak = the reference's maximum finite channel value
  *   SSIM                   Wang et al. 2004 on the Rec.709 luma of the tonemapped sRGB images
  *   FLIP                   LDR-FLIP (Andersson et al. 2020) and HDR-FLIP (Andersson et al. 2021)
+ *   Temporal instability   a sequence's frame-to-frame change against the reference's
  *
  * Inputs have 3 or 4 channels (a 4th is ignored) and equal sizes; anything else throws
  * gilab::Error. Non-finite pixels are never averaged away: every result carries the counts of
@@ -321,5 +322,61 @@ MetricSet computeMetrics(const Image& test, const Image& reference, const Metric
 /** snake_case keys; non-finite numbers (e.g. PSNR +inf of equal images) are written as null. */
 nlohmann::ordered_json toJson(const MetricSet& metrics);
 nlohmann::ordered_json toJson(const FlipStats& stats);
+
+// ---------------------------------------------------------------------------------------------
+// Temporal instability (experiments/metrics/temporal.cpp; docs/metrics.md, "Temporal
+// instability")
+// ---------------------------------------------------------------------------------------------
+
+/**
+ * How much a technique's frame-to-frame change differs from the reference's over a sequence:
+ * per pixel p and consecutive pair k, d_k(p) = |(Y(T_{k+1}) − Y(T_k)) − (Y(R_{k+1}) − Y(R_k))|
+ * on Rec.709 luminance Y. Relative values are divided by the reference's level (its mean
+ * luminance over all frames and region pixels). A technique that flickers or lags scores worse
+ * even when each frame on its own looks right.
+ */
+struct TemporalResult {
+    int frames = 0;             // frames in the sequence
+    int pairs = 0;              // consecutive pairs, frames − 1 (0 with fewer than 2 frames)
+    size_t regionPixels = 0;    // pixels in the region (the whole image without a mask)
+    size_t samples = 0;         // (pixel, pair) samples pooled
+    size_t skippedPixels = 0;   // (pixel, pair) samples left out: non-finite in any input
+    double level = kNaN;        // mean Y of the reference, all frames, finite region pixels
+    double meanAbs = kNaN;      // mean d (absolute, linear luminance)
+    double instability = kNaN;  // meanAbs / level: "temporal_instability" (dimensionless)
+    double p95 = kNaN;          // 95th percentile (nearest rank) of d / level
+    double noiseFloor = kNaN;   // mean of s·sqrt(2/π) / level; NaN without stderr images
+    double debiased = kNaN;     // max(0, instability − noiseFloor); NaN without stderr images
+    std::string note;           // why a value is NaN (and other caveats); empty if none
+    /**
+     * 1 channel, full size: per pixel, the mean of d over its pooled pairs (absolute, linear
+     * luminance). Computed for every pixel (the mask only restricts the pooling); NaN where no
+     * pair is finite. Empty with fewer than 2 frames.
+     */
+    Image map;
+};
+
+/**
+ * test[k] and reference[k] are frame k of the technique and of the reference (3 or 4 channels,
+ * a 4th is ignored, all one size). referenceStdError, if given, holds each reference frame's
+ * per-pixel, per-channel standard error of the mean (one per frame, same size). Throws
+ * gilab::Error naming the frame on a null image, a size or channel mismatch, or sequences of
+ * different lengths. Fewer than 2 frames: pairs = 0, every value NaN (not an error).
+ */
+TemporalResult computeTemporalInstability(
+    const std::vector<const Image*>& test, const std::vector<const Image*>& reference,
+    const std::vector<const Image*>* referenceStdError = nullptr, const Mask* mask = nullptr);
+
+/** snake_case keys, without the map; non-finite numbers are written as null. */
+nlohmann::ordered_json toJson(const TemporalResult& result);
+
+/**
+ * The map of a TemporalResult as a magma PNG, normalised like the relMSE map: each pixel is
+ * d / (fullScale · level), clamped to [0, 1] (1 = a mean change error of fullScale times the
+ * reference's level). Where the level is not positive, the map's largest finite value is 1.
+ * NaN pixels are magenta.
+ */
+void writeTemporalMapPng(const std::string& path, const TemporalResult& result,
+                         double fullScale = 1.0);
 
 }  // namespace gilab::metrics

@@ -59,7 +59,15 @@ SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defa
 ReferenceRequest parseReference(const JsonNode& node) {
     ReferenceRequest r;
     node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce", "seed",
-                     "estimator", "batch_spp", "pixel_filter"});
+                     "estimator", "batch_spp", "pixel_filter", "frames"});
+    if (node.has("frames")) {
+        const JsonNode f = node["frames"];
+        if (f.raw().is_string()) {
+            if (f.string() != "all") f.fail("expected \"all\" or an integer k (every k-th frame)");
+        } else {
+            r.frameStep = f.integerIn(1, 10000);
+        }
+    }
     if (node.has("spp")) r.stop.maxSamples = uint64_t(node["spp"].integerIn(1, 1 << 24));
     if (node.has("rel_error")) r.stop.targetRelError = node["rel_error"].numberIn(0.0, 10.0);
     if (node.has("time_s")) r.stop.maxSeconds = node["time_s"].numberIn(0.0, 1e7);

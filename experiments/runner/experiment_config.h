@@ -30,6 +30,9 @@ struct SceneEntry {
 struct ReferenceRequest {
     ref::ReferenceSettings settings;
     ref::StopCriteria stop;
+    /** Animated scenes: the reference (and the per-frame metrics) cover every frameStep-th
+     *  frame, starting at 0 ("frames": "all" = 1, or an integer k). */
+    int frameStep = 1;
 };
 
 struct TimingPolicy {

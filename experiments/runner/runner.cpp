@@ -6,9 +6,11 @@
 #include <fstream>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "core/image/image_io.h"
 #include "core/passes/shared_passes.h"
+#include "core/scene/animation.h"
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
 #include "core/technique/registry.h"
@@ -21,6 +23,7 @@
 #include "experiments/runner/experiment_config.h"
 #include "experiments/runner/reference_set.h"
 #include "experiments/runner/run_metrics.h"
+#include "experiments/runner/run_sequence.h"
 #include "experiments/runner/run_store.h"
 #include "experiments/runner/timing_probe.h"
 #include "reference/scene_hash.h"
@@ -48,6 +51,9 @@ public:
         }
         for (const std::string& w : scene->warnings)
             std::fprintf(stderr, "gilab: %s: warning: %s\n", entry.label.c_str(), w.c_str());
+        // An animated scene starts at frame 0 of its animation (its static frames, set-up and
+        // references are those of frame 0).
+        if (scene->animation.animated()) applyFrameState(*scene, frameState(*scene, 0));
         return *m_scenes.emplace(entry.label, std::move(scene)).first->second;
     }
 
@@ -55,9 +61,9 @@ private:
     std::map<std::string, std::unique_ptr<Scene>> m_scenes;
 };
 
-/** Everything that changes a run's result, hashed: the run key. */
-nlohmann::ordered_json runIdentity(const ExperimentConfig& config, const RunSpec& run,
-                                   const Scene& scene) {
+/** Everything that changes a static run's result. */
+nlohmann::ordered_json runIdentityStatic(const ExperimentConfig& config, const RunSpec& run,
+                                         const Scene& scene) {
     return {{"run_format", kRunFormatVersion},
             {"scene_label", run.scene->label},
             {"reference_key", ref::referenceKey(scene, config.reference.settings)},
@@ -68,6 +74,35 @@ nlohmann::ordered_json runIdentity(const ExperimentConfig& config, const RunSpec
             {"warmup", config.timing.warmupFrames},
             {"frames", config.timing.timedFrames},
             {"metrics", metricsSpecJson(config.metrics)}};
+}
+
+/** The scene at frame `frame` of its animation (lights and camera moved; same geometry). */
+Scene sceneAtFrame(const Scene& scene, int frame) {
+    Scene s = scene;
+    applyFrameState(s, frameState(scene, frame));
+    return s;
+}
+
+/** Animated scenes: the reference keys of the measured frames (they change with any track). */
+nlohmann::ordered_json sequenceIdentity(const ExperimentConfig& config, const Scene& scene) {
+    if (!scene.animation.animated()) return nullptr;
+    nlohmann::ordered_json keys = nlohmann::ordered_json::array();
+    for (int f : measuredFrames(scene.animation.frameCount, config.reference.frameStep))
+        keys.push_back(ref::referenceKey(sceneAtFrame(scene, f), config.reference.settings));
+    return {{"frames", scene.animation.frameCount},
+            {"duration_s", scene.animation.duration},
+            {"frame_step", config.reference.frameStep},
+            {"reference_keys", keys}};
+}
+
+/** Everything that changes a run's result, hashed: the run key. Static scenes keep the keys
+ *  they had before animation existed. */
+nlohmann::ordered_json runIdentity(const ExperimentConfig& config, const RunSpec& run,
+                                   const Scene& scene) {
+    nlohmann::ordered_json id = runIdentityStatic(config, run, scene);
+    nlohmann::ordered_json sequence = sequenceIdentity(config, scene);
+    if (!sequence.is_null()) id["sequence"] = std::move(sequence);
+    return id;
 }
 
 struct Context {
@@ -83,23 +118,25 @@ struct Context {
     std::string configHash;
 };
 
-const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene) {
-    auto it = c.references.find(entry.label);
+/** The reference of `scene` (frame `frame` of an animated entry; -1 = the static scene). */
+const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene,
+                                 int frame = -1) {
+    const std::string id = frame < 0 ? entry.label : entry.label + "@" + std::to_string(frame);
+    auto it = c.references.find(id);
     if (it != c.references.end()) return *it->second;
     ref::ObtainOptions opts;
     opts.cancel = c.cancel;
     opts.sidecarExtra["scene"] = cli::sceneToJson(scene);
     opts.sidecarExtra["provenance"] = cli::provenanceJson(c.options.commandLine);
-    std::fprintf(stderr, "[gilab] reference for %s\n", entry.label.c_str());
+    std::fprintf(stderr, "[gilab] reference for %s\n", id.c_str());
     ref::ReferenceResult r = ref::obtainReference(scene, c.config.reference.settings,
                                                   c.config.reference.stop, c.cache, opts);
     for (const std::string& w : r.warnings)
         std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
     if (!r.complete)
-        throw Error("reference for " + entry.label + " was interrupted (" +
-                    ref::stopReasonName(r.reason) + "); runs need a complete reference");
-    return *c.references.emplace(entry.label, std::make_unique<ReferenceSet>(std::move(r)))
-                .first->second;
+        throw Error("reference for " + id + " was interrupted (" + ref::stopReasonName(r.reason) +
+                    "); runs need a complete reference");
+    return *c.references.emplace(id, std::make_unique<ReferenceSet>(std::move(r))).first->second;
 }
 
 /**
@@ -146,6 +183,24 @@ nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry
         out["indirect_png"] = rel + "indirect_" + bounces + ".png";
     }
     return out;
+}
+
+std::string framePreviewName(int frame) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%03d_full.png", frame);
+    return name;
+}
+
+/** references/<label>/frames/NNN_full.png: the full reference of an animation frame. */
+void writeReferenceFramePreview(Context& c, const SceneEntry& entry, int frame,
+                                const ReferenceSet& set, const ToneMap& tm) {
+    const std::string safeLabel = sanitizeLabel(entry.label);
+    const std::string id = safeLabel + "/frames/" + framePreviewName(frame);
+    if (c.writtenReferencePreviews[id]) return;
+    const fs::path dir = c.store.dir() / "references" / safeLabel / "frames";
+    fs::create_directories(dir);
+    writePngTonemapped((dir / framePreviewName(frame)).string(), set.match(kAllBounces).full, tm);
+    c.writtenReferencePreviews[id] = true;
 }
 
 /** Prints where the messages of an invalid run are (the first ones went to stderr already). */
@@ -270,6 +325,31 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
     result["timing"] = cli::timingJson(setup, frames, c.config.timing.warmupFrames);
+    std::optional<SequenceResult> sequence;
+    if (scene.animation.animated()) {
+        // Frames 1..N-1 in order after the static frames at frame 0 (docs/experiments.md).
+        const std::vector<int> measured =
+            measuredFrames(scene.animation.frameCount, c.config.reference.frameStep);
+        SequenceInputs in{scene,
+                          claimedBounces(info, run.params),
+                          measured,
+                          layers,
+                          [&](int f) -> const ReferenceSet& {
+                              const Scene frameScene = sceneAtFrame(scene, f);
+                              const ReferenceSet& set = referenceFor(c, *run.scene, frameScene, f);
+                              writeReferenceFramePreview(c, *run.scene, f, set, tm);
+                              return set;
+                          },
+                          c.config.metrics,
+                          tm,
+                          tmp};
+        sequence = runSequence(*harness, in);
+        result["timing"].update(sequence->timing);
+        result["animation"] = {{"frames", scene.animation.frameCount},
+                               {"duration_s", scene.animation.duration},
+                               {"measured_frames", measured},
+                               {"update", sequence->update}};
+    }
     result["memory"] = cli::memoryJson(harness->memory());
     result["skipped_passes"] = harness->skipped();
     result["notes"] = harness->notes();
@@ -286,6 +366,17 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                          {"final_png", "final.png"},
                          {"indirect_png", "indirect.png"},
                          {"flip_png", "flip.png"}};
+    if (sequence) {
+        result["metrics"]["sequence"] = sequence->metrics;
+        result["outputs"]["frames_png"] = sequence->framePngs;
+        if (!sequence->temporalPng.empty())
+            result["outputs"]["temporal_png"] = sequence->temporalPng;
+        nlohmann::ordered_json refFrames = nlohmann::ordered_json::array();
+        for (int f : result["animation"]["measured_frames"])
+            refFrames.push_back("../../references/" + sanitizeLabel(run.scene->label) + "/frames/" +
+                                framePreviewName(f));
+        result["reference"]["frames_png"] = refFrames;
+    }
     return commitResult(c, result, tmp, key, {.supported = true, .nonFinitePixels = nonFinite});
 }
 

@@ -63,6 +63,8 @@ def figure_bases(runs: list[Run]) -> list[Basis]:
     """The rows of a scene's error-vs-time figure: its headline basis first (the full reference
     when measured), then the bounce-matched view, then the one-bounce one where it applies."""
     headline = scene_basis(runs)
+    if headline.name == "sequence":  # an animated scene: means over the measured frames
+        return [headline, headline.matched_view]
     bases = [headline] + ([MATCHED] if headline is FULL else [])
     return bases + ([ONE_BOUNCE] if has_one_bounce(runs) else [])
 
@@ -90,6 +92,17 @@ def write_figures(results: Results, colors: dict[str, str], fig_dir: str) -> Fig
             path = os.path.join(fig_dir, f"passes_{slug(scene)}.svg")
             report_figures.passes_figure(best, colors, passes, path, scene)
             figures.passes[scene] = path
+        animated = [r for r in scene_runs if r.measured and r.animated]
+        if any(f.vs_full.flip_mean is not None or f.matched.flip_mean is not None
+               for r in animated for f in r.anim.sequence):
+            path = os.path.join(fig_dir, f"sequence_{slug(scene)}.svg")
+            report_figures.sequence_figure(animated, colors, path, scene)
+            figures.sequence[scene] = path
+        if any(r.anim.temporal.instability is not None
+               or r.anim.temporal_matched.instability is not None for r in animated):
+            path = os.path.join(fig_dir, f"temporal_{slug(scene)}.svg")
+            report_figures.temporal_figure(animated, colors, path, scene)
+            figures.temporal[scene] = path
     for sweep in find_sweeps(runs):
         why = no_effect(sweep)
         if why:

@@ -7,9 +7,9 @@ import hashlib
 import math
 import re
 from dataclasses import dataclass
-from typing import Callable, Optional
+from typing import Any, Callable, Optional
 
-from report_data import MetricView, Run, num, text
+from report_data import Animation, MetricView, Run, num, text
 from report_noise import front_ties
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
@@ -163,11 +163,20 @@ class Basis:
     rel_mse: Callable[[Run], Optional[float]]
     rel_mse_sigma: Callable[[Run], Optional[float]]
     group: Callable[[Run], str]
+    suffix: str = ""  # ", mean over the 5 measured frames" on an animated scene
+    # The second view of the scene (the bounce-matched errors): MATCHED when None.
+    second: Optional["Basis"] = None
 
     def label(self, metric: str = "HDR-FLIP", group: str = "") -> str:
-        """'HDR-FLIP vs full reference', 'relMSE vs bounce-matched reference (emission+direct)'."""
+        """'HDR-FLIP vs full reference', 'relMSE vs bounce-matched reference (emission+direct)',
+        'HDR-FLIP vs full reference, mean over the 5 measured frames'."""
         detail = f" ({group})" if group and self.name == "matched" else ""
-        return f"{metric} vs {self.reference}{detail}"
+        return f"{metric} vs {self.reference}{detail}{self.suffix}"
+
+    @property
+    def matched_view(self) -> "Basis":
+        """The bounce-matched basis shown next to this one (frame means on an animated scene)."""
+        return self.second or MATCHED
 
 
 MATCHED = Basis("matched", "vs. the bounce-matched reference (the light paths the technique "
@@ -210,10 +219,51 @@ def baseline_value(baseline: Optional[Run], bounces: Optional[int],
     return metric(view) if view is not None else None
 
 
+def _anim(run: Run) -> Any:
+    return run.anim if run.anim is not None else _NO_ANIMATION
+
+
+_NO_ANIMATION = Animation()
+
+
+def frames_phrase(runs: list[Run]) -> str:
+    """', mean over the 5 measured frames' (or each run's, when the runs differ)."""
+    counts = {_anim(r).measured_count for r in runs if r.measured and r.animated} - {None}
+    if len(counts) == 1:
+        n = counts.pop()
+        return f", mean over the {n} measured frame{'s' if n != 1 else ''}"
+    return ", mean over each run's measured frames"
+
+
+def sequence_bases(runs: list[Run]) -> tuple[Basis, Basis]:
+    """An animated scene's headline basis (HDR-FLIP vs the full reference, mean over the
+    measured frames: metrics.sequence.full_flip_mean) and its bounce-matched view
+    (matched_flip_mean), both named with the number of frames."""
+    suffix = frames_phrase(runs)
+    matched = Basis("matched", MATCHED.caption + ", mean over the measured frames",
+                    MATCHED.reference, lambda r: _anim(r).matched_flip_mean, lambda r: None,
+                    lambda r: _anim(r).matched_rel_mse_mean, lambda r: None,
+                    MATCHED.group, suffix)
+    full = Basis("sequence", FULL.caption + ", mean over the measured frames", FULL.reference,
+                 lambda r: _anim(r).full_flip_mean, lambda r: None,
+                 lambda r: _anim(r).full_rel_mse_mean, lambda r: None, FULL.group, suffix,
+                 matched)
+    return full, matched
+
+
+def is_animated_scene(runs: list[Run]) -> bool:
+    return any(r.animated for r in runs)
+
+
 def scene_basis(runs: list[Run]) -> Basis:
-    """The one basis every headline number and ranking of a scene uses: FULL when any measured
-    run of the scene has errors against the full reference, else MATCHED (older results)."""
-    return FULL if any(FULL.flip(r) is not None for r in runs if r.measured) else MATCHED
+    """The one basis every headline number and ranking of a scene uses: on an animated scene the
+    mean over the measured frames against the full reference when any measured run has it;
+    else FULL when any measured run of the scene has errors against the full reference, else
+    MATCHED (older results)."""
+    measured = [r for r in runs if r.measured]
+    if any(r.animated and _anim(r).full_flip_mean is not None for r in measured):
+        return sequence_bases(runs)[0]
+    return FULL if any(FULL.flip(r) is not None for r in measured) else MATCHED
 
 
 def comparable_groups(runs: list[Run], basis: Basis,

@@ -38,6 +38,21 @@ table.meta td:first-child { color: var(--muted); white-space: nowrap; }
 .b-front { background: #fff3c4; color: #6b5200; }
 .b-tie { background: #e8e8f4; color: #33336b; border: 1px dashed #8888aa; }
 .basis { font-weight: 600; }
+.b-update { background: #e3eefa; color: #0b3d75; }
+.b-rebuild { background: #b3261e; color: #fff; font-weight: 600; }
+.b-stale { background: #fde9d7; color: #8a3b00; font-weight: 600; }
+.b-quiet { background: #e3f3e6; color: #17602a; }
+table.strip { border-collapse: collapse; font-size: 11px; margin: 6px 0 12px; }
+table.strip th, table.strip td { padding: 2px 3px; vertical-align: middle; text-align: center; }
+table.strip thead th { color: var(--muted); font-weight: 400; }
+table.strip tbody th { text-align: left; font-weight: 400; max-width: 220px; font-size: 12px; }
+table.strip td.tmap { padding-left: 12px; border-left: 2px solid var(--line); }
+table.strip tr.strip-ref th { font-weight: 600; }
+table.strip .badge { white-space: normal; }
+table.data.cost th, table.data.sequence-errors th { white-space: normal; min-width: 70px; max-width: 190px;
+                                          vertical-align: bottom; }
+.card-nums .static { color: #444; }
+.card-nums { max-width: 640px; }
 .card-nums .headline { font-size: 13px; }
 .card-nums .second { color: #333; }
 .card-links { font-size: 12px; margin-top: 2px; }

@@ -25,6 +25,8 @@ class Figures:
     passes: dict[str, str] = field(default_factory=dict)  # scene -> svg
     sweeps: list[tuple[Sweep, str]] = field(default_factory=list)
     no_effect: list[tuple[Sweep, str]] = field(default_factory=list)  # sweep, why (no figure)
+    sequence: dict[str, str] = field(default_factory=dict)  # animated scene -> per-frame error
+    temporal: dict[str, str] = field(default_factory=dict)  # animated scene -> instability bars
 
 
 @dataclass
@@ -207,3 +209,26 @@ def first_message_html(run: Run) -> str:
 
 def scene_anchor(scene: str) -> str:
     return "scene-" + slug(scene)
+
+
+# How an animated scene's run brings its global illumination up to date after the light or
+# camera moved (animation.update), as a badge; "full rebuild" and "none" are flagged.
+UPDATE_WORDS = {
+    "incremental": ("b-update", "update: incremental",
+                    "the technique updates only what the motion changed"),
+    "full rebuild": ("b-rebuild", "update: full rebuild \u2014 no real update path",
+                     "the technique has no real update path: it rebuilds everything whenever "
+                     "the light or camera moves, so its dynamic frame pays the whole set-up"),
+    "none": ("b-stale", "update: none \u2014 stale",
+             "the technique does not update: its indirect light stays that of the first frame"),
+}
+
+
+def update_badge(run: Run) -> str:
+    """The run's update kind as a badge ('' for a static scene or when not recorded)."""
+    kind = run.anim.update if run.anim is not None else ""
+    if not kind:
+        return ""
+    css, label, tip = UPDATE_WORDS.get(kind, ("b-update", f"update: {kind}", ""))
+    return (f'<span class="badge {css}" data-update="{esc(kind)}" title="{esc(tip)}">'
+            f"{esc(label)}</span>")

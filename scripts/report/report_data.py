@@ -118,6 +118,182 @@ class MetricView:
 
 
 @dataclass
+class TimeSummary:
+    """One timing block (median, q1, q3, iqr) of result.json's timing; None = not recorded."""
+
+    median: Optional[float] = None
+    q1: Optional[float] = None
+    q3: Optional[float] = None
+    iqr: Optional[float] = None
+    source: str = ""  # "gpu" (timestamps), "cpu" (CPU clock) or ""
+
+    @staticmethod
+    def parse(summary: Any, source: str = "") -> "TimeSummary":
+        summary = summary if isinstance(summary, dict) else {}
+        q1, q3 = num(summary.get("q1")), num(summary.get("q3"))
+        iqr = num(summary.get("iqr"))
+        if iqr is None and q1 is not None and q3 is not None:
+            iqr = q3 - q1
+        median = num(summary.get("median"))
+        return TimeSummary(median, q1, q3, iqr, source if median is not None else "")
+
+
+@dataclass
+class Temporal:
+    """A temporal-instability block (toJson(TemporalResult), docs/metrics.md "Temporal
+    instability"): how wrong the frame-to-frame change is, relative to the reference's level."""
+
+    instability: Optional[float] = None  # temporal_instability
+    p95: Optional[float] = None
+    noise_floor: Optional[float] = None
+    debiased: Optional[float] = None
+    mean_abs: Optional[float] = None
+    level: Optional[float] = None
+    frames: Optional[float] = None
+    pairs: Optional[float] = None
+    samples: Optional[float] = None
+    skipped: Optional[float] = None  # skipped_pixels
+    note: str = ""
+
+    @staticmethod
+    def parse(block: Any) -> "Temporal":
+        block = block if isinstance(block, dict) else {}
+        return Temporal(num(block.get("temporal_instability")), num(block.get("p95")),
+                        num(block.get("noise_floor")), num(block.get("debiased")),
+                        num(block.get("mean_abs")), num(block.get("level")),
+                        num(block.get("frames")), num(block.get("pairs")),
+                        num(block.get("samples")), num(block.get("skipped_pixels")),
+                        text(block.get("note")) if isinstance(block.get("note"), str) else "")
+
+    @property
+    def within_noise(self) -> bool:
+        """The instability is no larger than the reference's noise floor: no measurable
+        instability (docs/metrics.md)."""
+        return (self.instability is not None and self.noise_floor is not None
+                and self.instability <= self.noise_floor)
+
+
+@dataclass
+class SequenceFrame:
+    """One measured frame of an animated run (metrics.sequence.frames[i])."""
+
+    frame: Optional[int]
+    time_s: Optional[float]
+    vs_full: "MetricView"  # final_vs_full: against the full reference of that frame
+    matched: "MetricView"  # final: against the bounce-matched reference of that frame
+
+
+def _mean(values: list[Optional[float]]) -> Optional[float]:
+    """The mean when every value is known (never a mean over a subset), else None."""
+    if not values or any(v is None for v in values):
+        return None
+    return sum(values) / len(values)
+
+
+@dataclass
+class Animation:
+    """What an animated scene's run adds (docs/report.md, "Animated scenes"); every part
+    optional."""
+
+    frames: Optional[int] = None  # animation.frames: frames of the animation
+    duration_s: Optional[float] = None
+    measured: list[int] = field(default_factory=list)  # animation.measured_frames
+    update: str = ""  # "incremental", "full rebuild", "none" or ""
+    sequence: list[SequenceFrame] = field(default_factory=list)
+    full_flip_mean: Optional[float] = None  # metrics.sequence.full_flip_mean
+    full_rel_mse_mean: Optional[float] = None
+    matched_flip_mean: Optional[float] = None
+    matched_rel_mse_mean: Optional[float] = None  # computed from the frames (not in JSON)
+    temporal: Temporal = field(default_factory=Temporal)
+    temporal_matched: Temporal = field(default_factory=Temporal)
+    dynamic: TimeSummary = field(default_factory=TimeSummary)  # dynamic_frame_{gpu,cpu}_ms
+    update_cpu: TimeSummary = field(default_factory=TimeSummary)  # update_cpu_ms
+    update_passes: list[tuple[str, Optional[float]]] = field(default_factory=list)
+
+    @property
+    def measured_count(self) -> Optional[int]:
+        """N, the number of measured frames the sequence means are taken over."""
+        for n in (len(self.measured), len(self.sequence), self.temporal.frames):
+            if n:
+                return int(n)
+        return None
+
+    def frame_times(self) -> list[Optional[float]]:
+        """The time (s) of each measured frame: sequence.frames[].time_s, else from the
+        duration (frames evenly spaced over duration_s)."""
+        if self.sequence and all(f.time_s is not None for f in self.sequence):
+            return [f.time_s for f in self.sequence]
+        out = []
+        for index in self.measured:
+            if self.duration_s is not None and self.frames and self.frames > 1:
+                out.append(self.duration_s * index / (self.frames - 1))
+            else:
+                out.append(None)
+        return out
+
+
+def parse_animation(data: dict) -> Optional["Animation"]:
+    """The animated-scene parts of a result.json, None for a static scene (no `animation` and no
+    `metrics.sequence` object)."""
+    block = dig(data, "animation")
+    sequence = dig(data, "metrics", "sequence")
+    if not isinstance(block, dict) and not isinstance(sequence, dict):
+        return None
+    block = _as_dict(block)
+    sequence = _as_dict(sequence)
+    frames = []
+    for entry in sequence.get("frames") if isinstance(sequence.get("frames"), list) else []:
+        if isinstance(entry, dict):
+            index = num(entry.get("frame"))
+            frames.append(SequenceFrame(int(index) if index is not None else None,
+                                        num(entry.get("time_s")),
+                                        MetricView.parse(entry.get("final_vs_full")),
+                                        MetricView.parse(entry.get("final"))))
+    measured = block.get("measured_frames")
+    measured = [int(num(i)) for i in measured if num(i) is not None] \
+        if isinstance(measured, list) else []
+    if not measured and frames and all(f.frame is not None for f in frames):
+        measured = [f.frame for f in frames]
+    count = num(block.get("frames"))
+    dynamic = TimeSummary()
+    for source in ("gpu", "cpu"):
+        dynamic = TimeSummary.parse(dig(data, "timing", f"dynamic_frame_{source}_ms"), source)
+        if dynamic.median is not None:
+            break
+    passes = dig(data, "timing", "update_passes")
+    update_passes = [(text(p.get("name")) or "?", num(dig(p, "gpu_ms", "median")))
+                     for p in (passes if isinstance(passes, list) else []) if isinstance(p, dict)]
+    update = block.get("update")
+    return Animation(
+        frames=int(count) if count is not None else None,
+        duration_s=num(block.get("duration_s")),
+        measured=measured,
+        update=update if isinstance(update, str) else "",
+        sequence=frames,
+        full_flip_mean=_sequence_mean(sequence, "full_flip_mean",
+                                      [f.vs_full.flip_mean for f in frames]),
+        full_rel_mse_mean=_sequence_mean(sequence, "full_rel_mse_mean",
+                                         [f.vs_full.rel_mse for f in frames]),
+        matched_flip_mean=_sequence_mean(sequence, "matched_flip_mean",
+                                         [f.matched.flip_mean for f in frames]),
+        matched_rel_mse_mean=_sequence_mean(sequence, "matched_rel_mse_mean",
+                                            [f.matched.rel_mse for f in frames]),
+        temporal=Temporal.parse(sequence.get("temporal")),
+        temporal_matched=Temporal.parse(sequence.get("temporal_matched")),
+        dynamic=dynamic,
+        update_cpu=TimeSummary.parse(dig(data, "timing", "update_cpu_ms"), "cpu"),
+        update_passes=update_passes)
+
+
+def _sequence_mean(sequence: dict, key: str, per_frame: list[Optional[float]]
+                   ) -> Optional[float]:
+    """metrics.sequence.<key> as the runner wrote it; when it is missing, the mean of the
+    per-frame values if every measured frame has one."""
+    value = num(sequence.get(key))
+    return value if value is not None else _mean(per_frame)
+
+
+@dataclass
 class Run:
     """One finished run (result.json) and the numbers derived from it."""
 
@@ -138,7 +314,9 @@ class Run:
     direct: MetricView  # direct-light layer vs. the reference's emission+direct (metrics.direct)
     regions: dict  # region name -> MetricView of its final layer
     energy_ratio: Optional[float]
-    frame_ms: Optional[float]  # median frame time (GPU, else CPU)
+    # The frame time every ranking, front and figure uses: the static frame (GPU, else CPU), or,
+    # on an animated scene, the dynamic frame (use_dynamic_clock).
+    frame_ms: Optional[float]
     frame_q1: Optional[float]
     frame_q3: Optional[float]
     frame_iqr: Optional[float]
@@ -151,6 +329,31 @@ class Run:
     claimed_bounces: Optional[int] = None  # technique.indirect_bounces (-1 = all)
     device_type: str = ""  # device.type: "cpu" (lavapipe), "discrete", "integrated", ...
     device_driver: str = ""  # device.driver
+    # The static frame (timing.frame_gpu_ms, else frame_cpu_ms), whatever the ranking clock is.
+    static: TimeSummary = field(default_factory=TimeSummary)
+    anim: Optional[Animation] = None  # None: a static scene's run
+    dynamic_clock: bool = False  # frame_* hold the dynamic frame (an animated scene)
+
+    @property
+    def animated(self) -> bool:
+        return self.anim is not None
+
+    def use_dynamic_clock(self) -> None:
+        """Ranks this run by its dynamic frame (light/camera moved, update included): frame_*
+        become the dynamic frame's numbers (None when it was not timed); `static` keeps the
+        static frame."""
+        dynamic = self.anim.dynamic if self.anim is not None else TimeSummary()
+        self.frame_ms, self.frame_q1, self.frame_q3 = dynamic.median, dynamic.q1, dynamic.q3
+        self.frame_iqr, self.frame_source = dynamic.iqr, dynamic.source
+        self.dynamic_clock = True
+
+    def output_list(self, name: str) -> list[Optional[str]]:
+        """Absolute paths of the list outputs.<name> (e.g. frames_png), None for an entry that
+        is not a string."""
+        return _path_list(dig(self.data, "outputs", name), self.folder)
+
+    def reference_list(self, name: str) -> list[Optional[str]]:
+        return _path_list(dig(self.data, "reference", name), self.folder)
 
     @property
     def measured(self) -> bool:
@@ -204,6 +407,13 @@ class Run:
 
     def reference_label(self) -> str:
         return text(dig(self.data, "reference", "matched"))
+
+
+def _path_list(value: Any, folder: str) -> list[Optional[str]]:
+    if not isinstance(value, list):
+        return []
+    return [os.path.normpath(os.path.join(folder, v)) if isinstance(v, str) and v else None
+            for v in value]
 
 
 @dataclass
@@ -282,6 +492,8 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
                          else None),
         device_type=text(dig(data, "device", "type")),
         device_driver=text(dig(data, "device", "driver")),
+        static=TimeSummary(num(frame.get("median")), q1, q3, iqr, source),
+        anim=parse_animation(data),
     )
 
 
@@ -341,4 +553,14 @@ def load_results(dirs: list[str]) -> Results:
                     continue
             by_key[item.key] = item
     results.runs = sorted(by_key.values(), key=_sort_key)
+    apply_clocks(results.runs)
     return results
+
+
+def apply_clocks(runs: list[Run]) -> None:
+    """On a scene with animated runs, every run of the scene is ranked by its dynamic frame
+    (a run without one is left out of the time rankings rather than mixed with them)."""
+    animated = {r.scene for r in runs if r.animated}
+    for run in runs:
+        if run.scene in animated:
+            run.use_dynamic_clock()

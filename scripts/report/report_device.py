@@ -6,6 +6,8 @@ rank techniques differently from a GPU. The report therefore never calls them GP
 """
 from __future__ import annotations
 
+from typing import Optional
+
 from report_data import Run
 
 LAVAPIPE = "lavapipe (CPU)"
@@ -33,10 +35,28 @@ def any_cpu_device(runs: list[Run]) -> bool:
     return any(r.device_type == "cpu" for r in runs)
 
 
-def time_label(runs: list[Run], what: str = "frame time", unit: str = "ms") -> str:
-    """An axis label or table header: 'frame time, lavapipe (CPU), ms'."""
+# What an animated scene's frame times are (docs/report.md, "Animated scenes").
+DYNAMIC_FRAME = "dynamic frame (light/camera moved, update included)"
+
+
+def dynamic_clock(runs: list[Run]) -> bool:
+    """Whether these runs are timed by their dynamic frame (all of an animated scene)."""
+    return bool(runs) and all(r.dynamic_clock for r in runs)
+
+
+def time_label(runs: list[Run], what: str = "frame time", unit: str = "ms",
+               dynamic: Optional[bool] = None) -> str:
+    """An axis label or table header: 'frame time, lavapipe (CPU), ms'; for runs ranked by their
+    dynamic frame (dynamic None: when every run is; True/False to force) 'frame time, dynamic
+    frame (light/camera moved, update included), lavapipe (CPU), ms'."""
+    if dynamic is None:
+        dynamic = dynamic_clock(runs)
+    if dynamic and "frame time" in what:
+        what = f"{what}, {DYNAMIC_FRAME}"
     label = f"{what}, {device_label(runs)}"
-    if any(r.frame_source == "cpu" for r in runs) and "frame time" in what:
+    sources = [r.frame_source for r in runs] if dynamic else \
+        [r.static.source or r.frame_source for r in runs]
+    if "cpu" in sources and "frame time" in what:
         label += " (CPU clock where no timestamps)"
     return f"{label}, {unit}" if unit else label
 

@@ -18,9 +18,10 @@ from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
 from report_analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E402
-                             param_value, pareto_fronts, pareto_ties, shade, sweep_x)
-from report_device import device_label, time_label  # noqa: E402
-from report_data import Run, text  # noqa: E402
+                             by_technique, param_value, params_text, pareto_fronts, pareto_ties,
+                             shade, sweep_x)
+from report_device import DYNAMIC_FRAME, device_label, dynamic_clock, time_label  # noqa: E402
+from report_data import Run, Temporal, text  # noqa: E402
 
 STYLE = {
     "svg.fonttype": "none",
@@ -41,6 +42,8 @@ STYLE = {
 }
 FRONT_STYLES = ("--", ":", "-.", (0, (6, 2, 1, 2, 1, 2)), (0, (1, 1)), (0, (8, 3)))
 IQR_GID = "iqr-bars"  # SVG id prefix of the frame-time IQR bars (the report's test looks for it)
+SEQUENCE_GID = "seq-line-"  # + run key: one line per run in the per-frame error figure
+TEMPORAL_GID = "temporal-bar-"  # + run key: one bar per run in the temporal-instability figure
 LOG_SPAN = 10.0  # use a log axis when the largest positive value is > LOG_SPAN x the smallest
 
 Metric = Callable[[Run], Optional[float]]
@@ -85,18 +88,44 @@ def _title(ax: plt.Axes, title: str, width: int = 52) -> None:
     ax.set_title(textwrap.fill(title, width), fontsize=9)
 
 
+def axis_time_label(runs: list[Run], what: str) -> str:
+    """time_label for an axis: the dynamic-frame wording on its own line (the device and the
+    unit stay together on the last line)."""
+    return time_label(runs, what).replace(f", {DYNAMIC_FRAME}", ", dynamic frame\n"
+                                          + DYNAMIC_FRAME[len("dynamic frame "):])
+
+
+def _static_marks(ax: plt.Axes, runs: list[Run], colors: dict[str, str], error: Metric
+                  ) -> list[float]:
+    """For runs timed by their dynamic frame: the static frame of the same run as a hollow
+    marker joined to it by a dotted line (the cost of the update and the motion, visible).
+    Returns the static times drawn."""
+    drawn = []
+    for run in runs:
+        if not run.dynamic_clock or run.static.median is None:
+            continue
+        ax.plot([run.static.median, run.frame_ms], [error(run), error(run)], ":", lw=0.8,
+                color=colors[run.technique], alpha=0.7, zorder=1)
+        ax.plot([run.static.median], [error(run)], "o", ms=5, mfc="white",
+                mec=colors[run.technique], mew=0.9, zorder=2)
+        drawn.append(run.static.median)
+    return drawn
+
+
 def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis: Basis,
                    error: Metric, sigma: Metric, ylabel: str) -> None:
     """Error against frame time, one colour per technique, the Pareto front of each group of
     comparable runs as a step line (runs on it ringed; runs tied with it within the noise in a
-    dashed grey ring)."""
+    dashed grey ring). On an animated scene the time is the dynamic frame's, and each run's
+    static frame is a hollow marker on the same error."""
     plotted = [r for r in runs if r.measured and r.frame_ms is not None and error(r) is not None]
     ax.set_ylabel(ylabel)
-    ax.set_xlabel(time_label([r for r in runs if r.measured], "median frame time"))
+    ax.set_xlabel(axis_time_label([r for r in runs if r.measured], "median frame time"))
     if not plotted:
         ax.text(0.5, 0.5, "no run has this metric", ha="center", va="center",
                 transform=ax.transAxes, color="#777777")
         return
+    statics = _static_marks(ax, plotted, colors, error)
     for tech in sorted({r.technique for r in plotted}):
         for status, marker, size in (("ok", "o", 5), ("nonfinite", "X", 8)):
             group = [r for r in plotted if r.technique == tech and r.status == status]
@@ -122,7 +151,7 @@ def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis:
     if tied:
         ax.plot([r.frame_ms for r in tied], [error(r) for r in tied], "o", ms=10, mfc="none",
                 mec="#777777", mew=0.9, ls="none", zorder=4, dashes=(2, 1))
-    if _wants_log([r.frame_ms for r in plotted]):
+    if _wants_log([r.frame_ms for r in plotted] + statics):
         ax.set_xscale("log")
         _log_axis(ax.xaxis)
     if _wants_log([error(r) for r in plotted]):
@@ -149,6 +178,9 @@ def _pareto_legend(fig: plt.Figure, runs: list[Run], colors: dict[str, str],
     if any(r.status == "nonfinite" for r in runs):
         handles.append(Line2D([], [], marker="X", ls="none", color="#999999", mec="black",
                               label="nonfinite output"))
+    if dynamic_clock([r for r in runs if r.measured]):
+        handles.append(Line2D([], [], marker="o", ls=":", color="#777777", mfc="white",
+                              label="static frame of the same run (nothing moved, no update)"))
     fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 4),
                bbox_to_anchor=(0.5, 0.0), frameon=False)
 
@@ -174,8 +206,12 @@ def pareto_figure(runs: list[Run], colors: dict[str, str], bases: list[Basis], p
                        "relMSE ↓")
         _title(row[0], _row_title(basis, runs, "HDR-FLIP"))
         _title(row[1], _row_title(basis, runs, "relMSE"))
-    fig.suptitle(f"{scene}: error against frame time (top row: the ranking basis)", fontsize=10,
-                 y=0.94 if len(bases) == 1 else 0.93)
+    what = "dynamic frame time" if dynamic_clock([r for r in runs if r.measured]) else \
+        "frame time"
+    lines = max(len(textwrap.wrap(_row_title(bases[0], runs, m), 52))
+                for m in ("HDR-FLIP", "relMSE"))
+    fig.suptitle(f"{scene}: error against {what} (top row: the ranking basis)", fontsize=10,
+                 y=(0.94 if len(bases) == 1 else 0.93) + 0.03 * (lines - 1) * (2 / len(bases)))
     _pareto_legend(fig, runs, colors, bases)
     _save(fig, path)
 
@@ -249,8 +285,11 @@ def _sweep_panels(sweep: Sweep, basis: Basis, baseline: Optional[Run]) -> list[S
                          basis.flip_sigma)]
     if basis.name != "matched":
         panels[0].baseline = basis.flip(baseline) if baseline is not None else None
-        panels.append(SweepPanel(_row_title(MATCHED, runs, "HDR-FLIP"), "mean HDR-FLIP ↓",
-                                 MATCHED.flip, MATCHED.flip_sigma,
+        second = basis.matched_view  # frame means on an animated scene
+        panels.append(SweepPanel(_row_title(second, runs, "HDR-FLIP"), "mean HDR-FLIP ↓",
+                                 second.flip, second.flip_sigma,
+                                 second.flip(baseline) if baseline is not None
+                                 and second is not MATCHED else
                                  baseline_value(baseline, bounces, lambda m: m.flip_mean)))
         panels.append(SweepPanel(basis.label("relMSE"), "relMSE ↓", basis.rel_mse,
                                  basis.rel_mse_sigma,
@@ -261,7 +300,12 @@ def _sweep_panels(sweep: Sweep, basis: Basis, baseline: Optional[Run]) -> list[S
                                  basis.rel_mse_sigma,
                                  baseline_value(baseline, bounces, lambda m: m.rel_mse)))
     measured = [r for r in runs if r.measured]
-    panels.append(SweepPanel("median frame time ± IQR", time_label(measured, "median frame time"),
+    dynamic = dynamic_clock(measured)
+    title = f"median time of the {DYNAMIC_FRAME} ± IQR" if dynamic else "median frame time ± IQR"
+    ylabel = time_label(measured, "median frame time")
+    if dynamic:  # the panel title says what a dynamic frame is; the axis stays short
+        ylabel = ylabel.replace(f"median frame time, {DYNAMIC_FRAME}", "dynamic frame")
+    panels.append(SweepPanel(title, ylabel,
                              lambda r: r.frame_ms, lambda r: None,
                              baseline.frame_ms if baseline is not None else None, True))
     return panels
@@ -363,8 +407,9 @@ def passes_figure(best: list[Run], tech_colors: dict[str, str], pass_colors: dic
 
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.9), gridspec_kw={"wspace": 0.75})
     _stacked_bars(axes[0], best, frame, lambda run, name: pass_colors[name])
-    axes[0].set_ylabel(time_label(best, "median time per frame"))
-    axes[0].set_title(f"per-frame time by pass ({device_label(best)})")
+    static = "static " if any(r.animated for r in best) else ""
+    axes[0].set_ylabel(time_label(best, f"median time per {static}frame"))
+    axes[0].set_title(f"per-{static}frame time by pass ({device_label(best)})")
     used = list(dict.fromkeys(n for stack in frame for n, _ in stack))
     _legend(axes[0], [(n, pass_colors[n]) for n in reversed(used)])
     _stacked_bars(axes[1], best, setup, setup_color)
@@ -377,4 +422,147 @@ def passes_figure(best: list[Run], tech_colors: dict[str, str], pass_colors: dic
         for tick, run in zip(ax.get_xticklabels(), best):
             tick.set_color(tech_colors.get(run.technique, "black"))
     fig.suptitle(f"{scene}: where the time goes (best run per technique)", fontsize=10, y=1.0)
+    _save(fig, path)
+
+
+# ---------------------------------------------------------------------------------------------
+# Animated scenes
+# ---------------------------------------------------------------------------------------------
+
+def run_tones(runs: list[Run], colors: dict[str, str]) -> dict[int, str]:
+    """id(run) -> its colour: the technique's, in shades when the technique has several runs."""
+    tones = {}
+    for members in by_technique(runs).values():
+        for i, run in enumerate(members):
+            base = colors.get(run.technique, "#888888")
+            tones[id(run)] = base if len(members) == 1 else shade(base, i, len(members))
+    return tones
+
+
+def run_name(run: Run) -> str:
+    """'tech_a (cone_count=4)': technique and swept parameters."""
+    swept = params_text(run, True)
+    return f"{run.technique} ({swept})" if swept else run.technique
+
+
+def _sequence_panel(ax: plt.Axes, runs: list[Run], tones: dict[int, str], full: bool) -> bool:
+    """Per measured frame: HDR-FLIP of each run against that frame's full (or bounce-matched)
+    reference, one line per run. Returns whether anything was drawn."""
+    values: list[float] = []
+    for run in runs:
+        frames = [f for f in run.anim.sequence if f.frame is not None]
+        points = [(f.frame, (f.vs_full if full else f.matched).flip_mean) for f in frames]
+        points = [(x, y) for x, y in points if y is not None]
+        if not points:
+            continue
+        line, = ax.plot([x for x, _ in points], [y for _, y in points], "-o", ms=4, lw=1.4,
+                        color=tones[id(run)], label=run_name(run),
+                        mec="black" if run.status == "nonfinite" else tones[id(run)])
+        line.set_gid(f"{SEQUENCE_GID}{'full' if full else 'matched'}-{run.key}")
+        values += [y for _, y in points]
+    if not values:
+        ax.text(0.5, 0.5, "no run has this metric", ha="center", va="center",
+                transform=ax.transAxes, color="#777777")
+        return False
+    if _wants_log(values):
+        ax.set_yscale("log")
+        _log_axis(ax.yaxis)
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
+    ax.set_xlabel("frame index (measured frames)")
+    ax.set_ylabel("mean HDR-FLIP ↓")
+    return True
+
+
+def sequence_figure(runs: list[Run], colors: dict[str, str], path: str, scene: str) -> None:
+    """HDR-FLIP against the frame index for every measured run of an animated scene: against
+    each frame's full reference (left, the basis of the scene's ranking, whose mean it is) and
+    against its bounce-matched reference (right)."""
+    drawn = [r for r in runs if r.measured and r.anim is not None and r.anim.sequence]
+    tones = run_tones(drawn, colors)
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.6), gridspec_kw={"wspace": 0.25})
+    _sequence_panel(axes[0], drawn, tones, True)
+    _title(axes[0], "HDR-FLIP vs full reference, per measured frame (its mean over the frames "
+           "ranks the scene)", 60)
+    has_matched = _sequence_panel(axes[1], drawn, tones, False)
+    labels = sorted({r.reference_label() for r in drawn if r.reference_label()})
+    detail = f" ({labels[0]})" if len(labels) == 1 else " (each run's own)"
+    _title(axes[1], f"HDR-FLIP vs bounce-matched reference{detail}, per measured frame", 60)
+    if not has_matched:
+        axes[1].set_visible(False)
+    handles, _ = axes[0].get_legend_handles_labels()
+    if handles:
+        fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 4),
+                   bbox_to_anchor=(0.5, 0.0), frameon=False)
+    fig.suptitle(f"{scene}: error of every measured frame (one line per run)", fontsize=10,
+                 y=1.04)
+    _save(fig, path)
+
+
+def _temporal_panel(ax: plt.Axes, runs: list[Run], tones: dict[int, str],
+                    block: Callable[[Run], Temporal], gid: str) -> bool:
+    """One bar per run (its temporal instability), the noise floor hatched over it up to the
+    floor with a black tick at the floor, p95 as a diamond. Returns whether anything was
+    drawn."""
+    shown = [r for r in runs if block(r).instability is not None]
+    if not shown:
+        ax.text(0.5, 0.5, "not measured", ha="center", va="center", transform=ax.transAxes,
+                color="#777777")
+        ax.set_xticks([])
+        return False
+    top = 0.0
+    for i, run in enumerate(shown):
+        t = block(run)
+        bars = ax.bar(i, t.instability, width=0.6, color=tones[id(run)], edgecolor="black",
+                      linewidth=0.5, zorder=2)
+        bars.patches[0].set_gid(f"{gid}{run.key}")
+        top = max(top, t.instability)
+        if t.noise_floor is not None:
+            ax.bar(i, t.noise_floor, width=0.6, facecolor="none", edgecolor="#222222",
+                   hatch="////", linewidth=0.0, zorder=3)
+            ax.plot([i - 0.38, i + 0.38], [t.noise_floor] * 2, color="black", lw=1.6, zorder=4)
+            top = max(top, t.noise_floor)
+        if t.p95 is not None:
+            ax.plot([i], [t.p95], "D", ms=5, color="white", mec="black", mew=1.0, zorder=5)
+            top = max(top, t.p95)
+        if t.within_noise:
+            ax.text(i, max(v for v in (t.instability, t.noise_floor, t.p95) if v is not None),
+                    "within the\nnoise floor", ha="center", va="bottom", fontsize=7,
+                    color="#17602a", zorder=6, linespacing=0.95,
+                    bbox={"boxstyle": "square,pad=0.3", "fc": "white", "ec": "none"})
+    labels = [textwrap.fill(run_name(r), 18) for r in shown]
+    rotate = len(labels) > 4
+    ax.set_xticks(range(len(shown)), labels, rotation=25 if rotate else 0,
+                  ha="right" if rotate else "center", fontsize=8)
+    for tick, run in zip(ax.get_xticklabels(), shown):
+        tick.set_color(tones[id(run)])
+    ax.set_ylim(0.0, top * 1.18 if top > 0 else 1.0)
+    ax.grid(axis="x", visible=False)
+    ax.set_ylabel("temporal instability ↓ (relative to the mean level)")
+    return True
+
+
+def temporal_figure(runs: list[Run], colors: dict[str, str], path: str, scene: str) -> None:
+    """Temporal instability of every measured run of an animated scene, against the full
+    reference's frames (left) and the bounce-matched reference's (right, where measured)."""
+    drawn = [r for r in runs if r.measured and r.anim is not None]
+    tones = run_tones(drawn, colors)
+    fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.8), gridspec_kw={"wspace": 0.3})
+    n = {int(r.anim.temporal.frames) for r in drawn if r.anim.temporal.frames} or \
+        {r.anim.measured_count for r in drawn if r.anim.measured_count}
+    frames = f" over {n.pop()} measured frames" if len(n) == 1 else ""
+    _temporal_panel(axes[0], drawn, tones, lambda r: r.anim.temporal, TEMPORAL_GID)
+    _title(axes[0], f"temporal instability vs full reference frames{frames}", 60)
+    if not _temporal_panel(axes[1], drawn, tones, lambda r: r.anim.temporal_matched,
+                           TEMPORAL_GID + "matched-"):
+        axes[1].set_visible(False)
+    _title(axes[1], f"temporal instability vs bounce-matched reference frames{frames}", 60)
+    handles = [Patch(facecolor="#bbbbbb", edgecolor="black", linewidth=0.5,
+                     label="temporal instability (mean |change − reference change| / level)"),
+               Patch(facecolor="white", edgecolor="#222222", hatch="////", linewidth=0.0,
+                     label="noise floor (what an exact technique scores): up to the black tick"),
+               Line2D([], [], marker="D", ls="none", color="white", mec="black",
+                      label="p95 of |change − reference change| / level")]
+    fig.legend(handles=handles, loc="upper center", ncol=3, bbox_to_anchor=(0.5, -0.02),
+               frameon=False)
+    fig.suptitle(f"{scene}: temporal instability (one bar per run)", fontsize=10, y=1.03)
     _save(fig, path)

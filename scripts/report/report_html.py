@@ -9,13 +9,14 @@ from __future__ import annotations
 import os
 from typing import Optional
 
-from report_analysis import MATCHED, Sweep, best_runs, by_scene, param_value, params_text
+from report_analysis import Sweep, best_runs, by_scene, param_value, params_text
 from report_assets import BODY_JS, CSS, HEAD_JS, MAGMA_STOPS
+from report_animation import animation_anchor, animation_html
 from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, esc,
                            fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
-                           rel_url, scene_anchor, status_badge, swatch, with_bar)
+                           rel_url, scene_anchor, status_badge, swatch, update_badge, with_bar)
 from report_data import Run, dig, num, text
-from report_device import device_label, time_label
+from report_device import DYNAMIC_FRAME, device_label, dynamic_clock, time_label
 from report_noise import change_words, tied_best, time_change_words
 from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
                            invalid_banner_html, run_table_html, skipped_html, unreadable_html)
@@ -32,26 +33,34 @@ def _metric_line(label: str, view_flip: Optional[float], sigma: Optional[float],
             f' · relMSE {fmt_sig(rel_mse)}</div>')
 
 
+def _time_line(css: str, median: Optional[float], iqr: Optional[float], label: str) -> str:
+    bar = f' <span class="pm">± {fmt_ms(iqr)}</span>' if iqr is not None else ""
+    return (f'<div class="{css}">{fmt_ms(median)}{bar} ms <span class="muted">{esc(label)}'
+            "</span></div>")
+
+
 def _card_numbers(run: Run, page: Page, ties: list[Run]) -> str:
-    """The headline number (the scene's basis), then the bounce-matched view and the direct-light
-    layer, each with its label."""
+    """The headline number (the scene's basis), the frame time (on an animated scene the dynamic
+    frame, then the static one), then the bounce-matched view and the direct-light layer, each
+    with its label."""
     basis = page.basis(run.scene)
     group = basis.group(run) if basis.name == "matched" else ""
     parts = [_metric_line(basis.label("HDR-FLIP", group), basis.flip(run), basis.flip_sigma(run),
                           basis.rel_mse(run), "headline")]
-    parts.append(f'<div class="time">{fmt_ms(run.frame_ms)} '
-                 f'<span class="pm">± {fmt_ms(run.frame_iqr)}</span> ms '
-                 f'<span class="muted">{esc(time_label([run], "frame time", ""))}</span></div>'
-                 if run.frame_iqr is not None else
-                 f'<div class="time">{fmt_ms(run.frame_ms)} ms <span class="muted">'
-                 f'{esc(time_label([run], "frame time", ""))}</span></div>')
-    if basis.name != "matched" and run.final.flip_mean is not None:
-        parts.append(_metric_line(MATCHED.label("HDR-FLIP", run.reference_label()),
-                                  run.final.flip_mean, run.final.flip_sigma, run.final.rel_mse,
+    parts.append(_time_line("time", run.frame_ms, run.frame_iqr,
+                            time_label([run], "frame time", "")))
+    if run.dynamic_clock:
+        parts.append(_time_line("time static", run.static.median, run.static.iqr,
+                                time_label([run], "static frame time", "", dynamic=False)))
+    second = basis.matched_view
+    if basis.name != "matched" and second.flip(run) is not None:
+        parts.append(_metric_line(second.label("HDR-FLIP", run.reference_label()),
+                                  second.flip(run), second.flip_sigma(run), second.rel_mse(run),
                                   "second") + '<div class="muted">the error of the light paths '
                      'the technique claims</div>')
     if run.direct.flip_mean is not None:
-        parts.append(_metric_line("direct light: HDR-FLIP vs reference emission+direct",
+        parts.append(_metric_line("direct light: HDR-FLIP vs reference emission+direct"
+                                  + (" (frame 0)" if run.animated else ""),
                                   run.direct.flip_mean, run.direct.flip_sigma,
                                   run.direct.rel_mse, "second"))
     if ties:
@@ -84,12 +93,14 @@ def _card(run: Run, page: Page, best: bool, lazy: bool, ties: list[Run]) -> str:
         badges += status_badge(run.status)
     if run.final.within_reference_noise:
         badges += '<span class="badge b-noise">within ref. noise</span>'
+    badges += update_badge(run)
     width = CARD_IMAGE_WIDTH
+    frame0 = " (frame 0)" if run.animated else ""
     figures = [(img_html(run.output_path("final_png"), page, f"{run.technique} final", width,
-                         "expo", lazy), "final")]
+                         "expo", lazy), "final" + frame0)]
     figures.append((img_html(run.output_path("flip_png"), page, f"{run.technique} FLIP map",
                              width, "flipmap", lazy),
-                    f"HDR-FLIP map vs {run.reference_label() or 'reference'}"))
+                    f"HDR-FLIP map vs {run.reference_label() or 'reference'}{frame0}"))
     if run.output_path("indirect_png"):
         figures.append((img_html(run.output_path("indirect_png"), page,
                                  f"{run.technique} indirect", width, "expo indirect", lazy),
@@ -213,7 +224,11 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
     basis_line = (f'<p class="basis-line">Ranked by <b class="basis">{esc(basis.label())}</b>'
                   + ("" if basis.name != "matched" else
                      " (no full-reference errors recorded: each technique is ranked against its "
-                     "own bounce-matched reference only)") + ".</p>")
+                     "own bounce-matched reference only)")
+                  + (f' and timed by the <b class="clock">{esc(DYNAMIC_FRAME)}</b>; the images '
+                     'are frame 0, every frame is in the <a href="#'
+                     f'{animation_anchor(scene)}">animation section</a>'
+                     if dynamic_clock(measured) else "") + ".</p>")
     return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{basis_line}'
             f'{_exposure_bar()}<div class="cards">{"".join(cards)}</div>{"".join(details)}'
             f'{note}</section>')
@@ -411,14 +426,14 @@ def passes_html(page: Page) -> str:
 # The page
 # ---------------------------------------------------------------------------------------------
 
-NAV_TITLES = (("images", "Images"), ("runs", "All runs"), ("pareto", "Error vs. time"),
+NAV_TITLES = (("images", "Images"), ("animation", "Animation"), ("runs", "All runs"), ("pareto", "Error vs. time"),
               ("sweeps", "Sweeps"), ("passes", "Time per pass"), ("equal", "Equal time/error"),
               ("skipped", "Skipped passes"), ("unreadable", "Unreadable"),
               ("definitions", "Definitions"))
 
 
 def render_page(page: Page) -> str:
-    sections = [invalid_banner_html(page), scenes_html(page),
+    sections = [invalid_banner_html(page), scenes_html(page), animation_html(page),
                 run_table_html(page) + failures_html(page), pareto_html(page),
                 sweeps_html(page), passes_html(page), equal_html(page), skipped_html(page),
                 unreadable_html(page)]

@@ -13,7 +13,7 @@ from report_analysis import (MIN_COMPARED, best_within_budget, by_scene, by_tech
                              params_text, slug, time_budgets)
 from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html, fmt_fixed,
                            fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, rel_url,
-                           status_badge, swatch, validation_summary, with_bar)
+                           status_badge, swatch, update_badge, validation_summary, with_bar)
 from report_data import Results, Run, dig, num, text
 from report_device import device_note_html, time_label
 from report_noise import error_separable, time_separable
@@ -176,10 +176,48 @@ def _memory_cell(run: Run) -> tuple[str, object]:
 
 
 def _frame_cell(run: Run) -> tuple[str, object]:
-    shown = with_bar(fmt_ms(run.frame_ms), run.frame_iqr, fmt_ms)
-    if run.frame_source == "cpu":
+    """The static frame (on an animated scene too: the dynamic one has its own column)."""
+    frame = run.static
+    shown = with_bar(fmt_ms(frame.median), frame.iqr, fmt_ms)
+    if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
-    return shown, run.frame_ms
+    return shown, frame.median
+
+
+def _dynamic_cell(run: Run) -> tuple[str, object]:
+    frame = run.anim.dynamic if run.anim is not None else None
+    if frame is None or frame.median is None:
+        return DASH, None
+    shown = with_bar(fmt_ms(frame.median), frame.iqr, fmt_ms)
+    if frame.source == "cpu":
+        shown += ' <span class="pm">(CPU clock)</span>'
+    return shown, frame.median
+
+
+def _update_cell(run: Run) -> tuple[str, object]:
+    kind = run.anim.update if run.anim is not None else ""
+    return (update_badge(run), kind) if kind else (DASH, None)
+
+
+def _sequence_cell(run: Run) -> tuple[str, object]:
+    anim = run.anim
+    value = anim.full_flip_mean if anim is not None else None
+    if value is None:
+        return DASH, None
+    n = anim.measured_count
+    return (fmt_flip(value) + (f' <span class="pm">({n} frames)</span>' if n else ""), value)
+
+
+def _temporal_cell(run: Run) -> tuple[str, object]:
+    block = run.anim.temporal if run.anim is not None else None
+    if block is None or block.instability is None:
+        return DASH, None
+    shown = fmt_fixed(block.instability, 4)
+    if block.noise_floor is not None:
+        shown += f' <span class="pm">floor {fmt_fixed(block.noise_floor, 4)}</span>'
+    if block.within_noise:
+        shown += ' <span class="badge b-quiet">within noise</span>'
+    return shown, block.instability
 
 
 def _status_cell(run: Run) -> tuple[str, object]:
@@ -246,7 +284,9 @@ def run_columns(page: Page) -> list[Column]:
     then cost; those no run has are dropped."""
     runs = page.results.runs
     measured = [r for r in runs if r.measured]
-    frame = time_label(measured, "frame time")
+    animated = [r for r in measured if r.animated]
+    frame = time_label(measured, "static frame time" if animated else "frame time",
+                       dynamic=False)
     cols = [
         Column("technique", "technique", "technique id",
                lambda r: (swatch(r.technique, page), r.technique), False, "tech"),
@@ -258,7 +298,24 @@ def run_columns(page: Page) -> list[Column]:
                "(Vulkan validation reported errors or warnings: numbers not trusted, not ranked)",
                _status_cell, False, "reason"),
         Column("frame", f"{frame} ± IQR", "median frame time over the timed frames ± IQR "
-               "(sum of the passes' timestamps on the device named)", _frame_cell),
+               "(sum of the passes' timestamps on the device named)"
+               + ("; on an animated scene the static frame (nothing moved)" if animated else ""),
+               _frame_cell),
+        Column("dynamic_frame", f"{time_label(animated, 'frame time', dynamic=True)} ± IQR",
+               "animated scenes: median time of a frame in which the light or camera moved, the "
+               "technique's update included (timing.dynamic_frame_gpu_ms, else _cpu_ms); the "
+               "time the scene's rankings use", _dynamic_cell),
+        Column("update", "update kind", "animated scenes: how the technique follows the motion "
+               "(incremental / full rebuild: no real update path / none)", _update_cell, False,
+               ""),
+        Column("flip_sequence", "HDR-FLIP vs full reference, mean over the measured frames",
+               "animated scenes: mean HDR-FLIP against each measured frame's full reference "
+               "(metrics.sequence.full_flip_mean): the scene's ranking basis (↓)",
+               _sequence_cell),
+        Column("temporal", "temporal instability vs full reference frames", "animated scenes: "
+               "how wrong the frame-to-frame change is, relative to the mean level, with the "
+               "reference's noise floor (docs/metrics.md); within the floor = no measurable "
+               "instability (↓)", _temporal_cell),
         Column("flip_full", "HDR-FLIP vs full reference", "mean HDR-FLIP of the final image "
                "against the full reference (all light paths): the ranking basis (↓)",
                _flip_cell(lambda r: r.vs_full)),
@@ -576,7 +633,11 @@ def footer_html(page: Page) -> str:
          "reference</i> (all light paths, <code>metrics.final_vs_full</code>), so a technique "
          "that leaves out bounces pays for the missing light. Results without it fall back to the "
          "bounce-matched reference, ranking only runs compared with the same one. No ranking "
-         "mixes references."),
+         "mixes references." + (
+             " On an <b>animated scene</b> the basis is the mean HDR-FLIP vs full reference over "
+             "the measured frames (<code>metrics.sequence.full_flip_mean</code>) and the time is "
+             "the <i>dynamic frame (light/camera moved, update included)</i>; the static frame "
+             "is shown next to it." if any(r.animated for r in page.results.runs) else "")),
         ("Errors", "\u201cvs bounce-matched reference\u201d: against the path-traced reference "
          "with the light paths the technique claims (emission, direct and its number of "
          "indirect bounces; <code>metrics.final</code>), the error of what it claims to render, "

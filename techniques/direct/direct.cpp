@@ -16,6 +16,10 @@ void DirectTechnique::setup(TechniqueContext& ctx) {
     ctx.note("baseline: indirect layer is zero by construction");
 }
 
+UpdateKind DirectTechnique::update(TechniqueContext&, const SceneChanges&) {
+    return UpdateKind::None;
+}
+
 void DirectTechnique::render(TechniqueContext&, VkCommandBuffer, FrameTargets&) {
     // Nothing to add: the harness clears the indirect layer and runs the shared direct pass.
 }

@@ -13,6 +13,8 @@ class DirectTechnique final : public Technique {
 public:
     static TechniqueInfo describe();
     void setup(TechniqueContext& ctx) override;
+    /** Nothing is precomputed: the shared passes follow the lights and camera by themselves. */
+    UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes) override;
     void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) override;
 };
 

@@ -1,8 +1,10 @@
 #include "techniques/dvs/dvs.h"
 
+#include <cstdio>
 #include <string>
 
 #include "core/passes/shared_passes.h"
+#include "core/scene/animation.h"
 #include "core/scene/scene.h"
 #include "core/technique/registry.h"
 #include "core/util/error.h"
@@ -50,29 +52,23 @@ void DvsTechnique::setup(TechniqueContext& ctx) {
                                                     ctx.shared.shadows(), s, ctx.tag("lighting"));
     ctx.submitTimed([&](VkCommandBuffer cmd) {
         m_voxelizer->record(cmd, ctx.timer);
-        {
-            PassScope pass(ctx, cmd, "voxel_direct");
-            m_lighting->recordDirect(cmd);
-        }
-        {
-            PassScope pass(ctx, cmd, "filter");
-            m_radiance->filter(cmd);
-        }
-        if (s.bounces >= 2) {
-            {
-                PassScope pass(ctx, cmd, "voxel_bounce");
-                m_lighting->recordBounce(cmd);
-            }
-            PassScope pass(ctx, cmd, "filter2");
-            m_radiance->filter(cmd);
-        }
+        recordVoxelLighting(ctx, cmd, s.bounces);
     });
-    m_lighting->releaseScratch();
+    // The G1 scratch volume stays: a light change re-runs G1 (issue 11)
     m_voxelizer->releaseAccumulators();
     m_trace = std::make_unique<DvsPixelTrace>(ctx.vk, ctx.shared, *m_radiance, ctx.tag("trace"));
 
+    const double n3 = double(s.voxelResolution) * s.voxelResolution * s.voxelResolution;
+    char kept[64];
+    std::snprintf(kept, sizeof(kept), "%.2f MiB",
+                  n3 * (s.bounces >= 2 ? 8.0 : 0.0) / (1024.0 * 1024.0));
     ctx.note("voxel grid " + std::to_string(s.voxelResolution) + "^3, voxel " +
-             std::to_string(grid.voxelSize()) + " m; lighting computed once (static lights)");
+             std::to_string(grid.voxelSize()) +
+             " m; voxel lighting computed at set-up and re-run (L1, F" +
+             std::string(s.bounces >= 2 ? ", G1, F" : "") +
+             ") when a light changes; kept for that: the voxelizer's volumes" +
+             std::string(s.bounces >= 2 ? " and the G1 scratch volume (" + std::string(kept) + ")"
+                                        : ""));
     if (ctx.scene.caps.hasEmissive)
         ctx.note("emitters light the voxels through the shared emitter samples (L1)");
     if (s.pixelShadows == DvsPixelShadows::Cone)
@@ -83,6 +79,35 @@ void DvsTechnique::setup(TechniqueContext& ctx) {
         ctx.skip("specular", "scene has no glossy materials");
     else if (!s.specular)
         ctx.skip("specular", "specular = false");
+}
+
+void DvsTechnique::recordVoxelLighting(TechniqueContext& ctx, VkCommandBuffer cmd, int bounces) {
+    {
+        PassScope pass(ctx, cmd, "voxel_direct");
+        m_lighting->recordDirect(cmd);  // writes every voxel of the base (0 where empty)
+    }
+    {
+        PassScope pass(ctx, cmd, "filter");
+        m_radiance->filter(cmd);
+    }
+    if (bounces >= 2) {
+        {
+            PassScope pass(ctx, cmd, "voxel_bounce");
+            m_lighting->recordBounce(cmd);
+        }
+        PassScope pass(ctx, cmd, "filter2");
+        m_radiance->filter(cmd);
+    }
+}
+
+UpdateKind DvsTechnique::update(TechniqueContext& ctx, const SceneChanges& changes) {
+    if (changes.geometry || !m_lighting) return Technique::update(ctx, changes);
+    if (changes.lights.empty()) return UpdateKind::None;  // camera only: P1 reads the G-buffer
+    // The harness has re-uploaded the pass light table and re-rendered the moved lights' shadow
+    // maps (a finished submission) before calling update(): L1 reads the new ones
+    const DvsSettings s = dvsSettingsFrom(ctx.params);
+    ctx.submitTimed([&](VkCommandBuffer cmd) { recordVoxelLighting(ctx, cmd, s.bounces); });
+    return UpdateKind::Incremental;
 }
 
 void DvsTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) {

@@ -414,19 +414,17 @@ LightViewPlan planLightViews(std::vector<GpuLightView> views, const VoxelGrid& g
 
 LightInjection::LightInjection(TechniqueContext& ctx, const VoxelGrid& grid, uint32_t mapResolution,
                                bool singleBatch)
-    : m_vk(ctx.vk), m_scene(ctx.gpuScene), m_grid(grid) {
+    : m_vk(ctx.vk), m_scene(ctx.gpuScene), m_grid(grid), m_mapResolution(mapResolution) {
     if (mapResolution != 0 && (mapResolution < 8 || mapResolution > 4096)) {
         throw Error("vct: light_map_resolution = " + std::to_string(mapResolution) +
                     " outside [8, 4096] (or 0 = from the texel footprint)");
     }
     const VkPhysicalDeviceLimits& deviceLimits = ctx.vk.properties().limits;
-    LightViewLimits limits;
-    limits.photonBufferBytes =
+    m_limits.photonBufferBytes =
         std::min<uint64_t>(deviceLimits.maxStorageBufferRange, uint64_t(128) << 20);
-    limits.maxImageDimension = deviceLimits.maxImageDimension2D;
-    limits.singleBatch = singleBatch;
-    m_plan = planLightViews(buildLightViews(ctx.scene, grid, ctx.shared.shadows().emitterSamples()),
-                            grid, mapResolution, limits);
+    m_limits.maxImageDimension = deviceLimits.maxImageDimension2D;
+    m_limits.singleBatch = singleBatch;
+    m_plan = makePlan(ctx);
     for (const std::string& note : m_plan.notes)
         ctx.note(note);
     if (m_plan.batches.size() > 1) {
@@ -435,55 +433,11 @@ LightInjection::LightInjection(TechniqueContext& ctx, const VoxelGrid& grid, uin
                  " photons, <= " + std::to_string(m_plan.maxBatchPhotons) + " per batch)");
     }
     m_floatAtomics = ctx.vk.hasFloatAtomics();
-
-    // Fixed-point scales: the whole flux of every light fits in 2^31 units, and so does the sum
-    // over lights of each light's largest photon irradiance (photons closer than v0 / 2 to a
-    // light are clamped to it), so no voxel overflows
-    double fluxBound = 0.0, irradianceBound = 0.0;
-    m_irradianceCap.assign(m_plan.lightCount, 0.0f);
-    const double rCap = 0.5 * double(grid.voxelSize());
-    for (const GpuLightView& v : m_plan.views) {
-        const glm::dvec3 f = lightViewFluxBound(v);
-        fluxBound += std::max({f.x, f.y, f.z});
-        const double i = std::max({v.intensity.x, v.intensity.y, v.intensity.z});
-        const double cap = isOrtho(v) ? i : i / (rCap * rCap);
-        m_irradianceCap[v.group.x] = float(std::max(double(m_irradianceCap[v.group.x]), cap));
-    }
-    for (float cap : m_irradianceCap)
-        irradianceBound += double(cap);
-    m_fixedScale = fluxBound > 0.0 ? 2.0e9 / fluxBound : 1.0;
-    m_fixedIrradianceScale = irradianceBound > 0.0 ? 2.0e9 / irradianceBound : 1.0;
-
-    const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
-                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT;
-    m_photons =
-        vk::Buffer(ctx.vk, std::max<uint64_t>(m_plan.maxBatchPhotons, 1) * sizeof(GpuPhoton),
-                   storage, vk::MemoryUsage::DeviceLocal, ctx.tag("photons"));
-    m_viewBuffer = vk::Buffer(
-        ctx.vk, std::max<size_t>(m_plan.views.size(), 1) * sizeof(GpuLightView),
-        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::DeviceLocal, ctx.tag("light_views"));
+    computeScales();
+    allocatePhotons(ctx, m_plan.maxBatchPhotons);
+    allocateViews(ctx, m_plan.views.size());
     m_viewBuffer.uploadVector(m_plan.views);
-
-    vk::ImageDesc map;
-    map.kind = vk::ImageKind::Image2DArray;
-    map.width = std::max(m_plan.maxWidth, 1u);
-    map.height = std::max(m_plan.maxHeight, 1u);
-    map.layers = std::max(m_plan.maxLayers, 1u);
-    map.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
-    map.format = kPositionFormat;
-    map.name = ctx.tag("light_view_positions");
-    m_positionMap = vk::Image(ctx.vk, map);
-    map.format = kNormalFormat;
-    map.name = ctx.tag("light_view_normals");
-    m_normalMap = vk::Image(ctx.vk, map);
-    vk::ImageDesc depth;
-    depth.format = kDepthFormat;
-    depth.width = map.width;
-    depth.height = map.height;
-    depth.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
-    depth.name = ctx.tag("light_view_depth");
-    m_depth = vk::Image(ctx.vk, depth);
+    allocateMaps(ctx, m_plan.maxWidth, m_plan.maxHeight, m_plan.maxLayers);
 
     m_rasterLayout = vk::PipelineLayout(ctx.vk, {m_scene.layout().handle()}, sizeof(LightViewPush));
     vk::GraphicsPipelineDesc desc;
@@ -505,12 +459,110 @@ LightInjection::LightInjection(TechniqueContext& ctx, const VoxelGrid& grid, uin
                                                  {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs}},
                                                 ctx.tag("photons"));
     m_photonSet = vk::DescriptorSet(ctx.vk, m_photonSetLayout, 0, ctx.tag("photons"));
+    writePhotonSet();
+    m_photonLayout = vk::PipelineLayout(ctx.vk, {m_photonSetLayout.handle()}, sizeof(glm::uvec4));
+    m_photonPipeline = vk::ComputePipeline(ctx.vk, "vct/photon_generate.comp", m_photonLayout);
+}
+
+LightViewPlan LightInjection::makePlan(TechniqueContext& ctx) const {
+    return planLightViews(buildLightViews(ctx.scene, m_grid, ctx.shared.shadows().emitterSamples()),
+                          m_grid, m_mapResolution, m_limits);
+}
+
+void LightInjection::computeScales() {
+    // Fixed-point scales: the whole flux of every light fits in 2^31 units, and so does the sum
+    // over lights of each light's largest photon irradiance (photons closer than v0 / 2 to a
+    // light are clamped to it), so no voxel overflows
+    double fluxBound = 0.0, irradianceBound = 0.0;
+    m_irradianceCap.assign(m_plan.lightCount, 0.0f);
+    const double rCap = 0.5 * double(m_grid.voxelSize());
+    for (const GpuLightView& v : m_plan.views) {
+        const glm::dvec3 f = lightViewFluxBound(v);
+        fluxBound += std::max({f.x, f.y, f.z});
+        const double i = std::max({v.intensity.x, v.intensity.y, v.intensity.z});
+        const double cap = isOrtho(v) ? i : i / (rCap * rCap);
+        m_irradianceCap[v.group.x] = float(std::max(double(m_irradianceCap[v.group.x]), cap));
+    }
+    for (float cap : m_irradianceCap)
+        irradianceBound += double(cap);
+    m_fixedScale = fluxBound > 0.0 ? 2.0e9 / fluxBound : 1.0;
+    m_fixedIrradianceScale = irradianceBound > 0.0 ? 2.0e9 / irradianceBound : 1.0;
+}
+
+void LightInjection::allocatePhotons(TechniqueContext& ctx, uint64_t photons) {
+    const VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                                       VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                                       VK_BUFFER_USAGE_TRANSFER_DST_BIT;
+    m_photonCapacity = std::max<uint64_t>(photons, 1);
+    m_photons = vk::Buffer(ctx.vk, m_photonCapacity * sizeof(GpuPhoton), storage,
+                           vk::MemoryUsage::DeviceLocal, ctx.tag("photons"));
+}
+
+void LightInjection::allocateViews(TechniqueContext& ctx, size_t views) {
+    m_viewCapacity = std::max<size_t>(views, 1);
+    m_viewBuffer = vk::Buffer(ctx.vk, m_viewCapacity * sizeof(GpuLightView),
+                              VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::DeviceLocal,
+                              ctx.tag("light_views"));
+}
+
+void LightInjection::allocateMaps(TechniqueContext& ctx, uint32_t width, uint32_t height,
+                                  uint32_t layers) {
+    vk::ImageDesc map;
+    map.kind = vk::ImageKind::Image2DArray;
+    map.width = std::max(width, 1u);
+    map.height = std::max(height, 1u);
+    map.layers = std::max(layers, 1u);
+    map.usage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
+    map.format = kPositionFormat;
+    map.name = ctx.tag("light_view_positions");
+    m_positionMap = vk::Image(ctx.vk, map);
+    map.format = kNormalFormat;
+    map.name = ctx.tag("light_view_normals");
+    m_normalMap = vk::Image(ctx.vk, map);
+    vk::ImageDesc depth;
+    depth.format = kDepthFormat;
+    depth.width = map.width;
+    depth.height = map.height;
+    depth.usage = VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT;
+    depth.name = ctx.tag("light_view_depth");
+    m_depth = vk::Image(ctx.vk, depth);
+}
+
+void LightInjection::writePhotonSet() {
     m_photonSet.writeStorageImage(0, m_positionMap.view());
     m_photonSet.writeStorageImage(1, m_normalMap.view());
     m_photonSet.writeBuffer(2, m_viewBuffer);
     m_photonSet.writeBuffer(3, m_photons);
-    m_photonLayout = vk::PipelineLayout(ctx.vk, {m_photonSetLayout.handle()}, sizeof(glm::uvec4));
-    m_photonPipeline = vk::ComputePipeline(ctx.vk, "vct/photon_generate.comp", m_photonLayout);
+}
+
+bool LightInjection::refresh(TechniqueContext& ctx) {
+    LightViewPlan plan = makePlan(ctx);
+    if (plan.views.size() != m_plan.views.size() || plan.lightCount != m_plan.lightCount)
+        throw Error("vct: the light views changed in number (a light changed type?)");
+    m_plan = std::move(plan);
+    m_recordedBatch = 0;
+    computeScales();
+    // Grow (never shrink) what the new plan does not fit; the rest is reused as it is
+    bool grown = false;
+    if (m_plan.maxBatchPhotons > m_photonCapacity) {
+        allocatePhotons(ctx, m_plan.maxBatchPhotons);
+        grown = true;
+    }
+    if (m_plan.views.size() > m_viewCapacity) {
+        allocateViews(ctx, m_plan.views.size());
+        grown = true;
+    }
+    const vk::ImageDesc& current = m_positionMap.desc();
+    if (m_plan.maxWidth > current.width || m_plan.maxHeight > current.height ||
+        m_plan.maxLayers > current.layers) {
+        allocateMaps(ctx, std::max(m_plan.maxWidth, current.width),
+                     std::max(m_plan.maxHeight, current.height),
+                     std::max(m_plan.maxLayers, current.layers));
+        grown = true;
+    }
+    m_viewBuffer.uploadVector(m_plan.views);
+    if (grown) writePhotonSet();
+    return grown;
 }
 
 PhotonSource LightInjection::photons() const {
@@ -775,8 +827,9 @@ std::vector<glm::vec3> LightInjection::readVoxelIrradiance() {
 
 size_t LightInjection::memoryBytes() const {
     size_t bytes = size_t(m_photons.size()) + size_t(m_viewBuffer.size());
-    const size_t texels = size_t(std::max(m_plan.maxWidth, 1u)) * std::max(m_plan.maxHeight, 1u);
-    bytes += texels * (16 + 8) * std::max<size_t>(m_plan.maxLayers, 1) + texels * 4;
+    const vk::ImageDesc& map = m_positionMap.desc();
+    const size_t texels = size_t(std::max(map.width, 1u)) * std::max(map.height, 1u);
+    bytes += texels * (16 + 8) * std::max<size_t>(map.layers, 1) + texels * 4;
     for (const vk::Buffer& b : m_flux)
         bytes += size_t(b.size());
     for (const vk::Buffer& b : m_irradiance)

@@ -27,7 +27,9 @@
  * (at most LightViewLimits::batchBytes each, unless one light needs more) to bound the scratch
  * memory; the octree needs them all at once in one storage buffer, so its maps shrink instead.
  * The photon buffer is also what the sparse voxel octree injects (techniques/vct/svo.h).
- * Lights are static, so this runs once in set-up (the paper re-injects when the light moves).
+ * Set-up injects once; when lights move (VctTechnique::update, issue 11) refresh() re-plans the
+ * views for the scene's current lights and the steps above are recorded again (as the paper
+ * re-injects when a light moves).
  */
 #include <algorithm>
 #include <cstdint>
@@ -157,6 +159,16 @@ public:
 
     /** The photons of the last recorded batch (all of them when batchCount() == 1). */
     PhotonSource photons() const;
+    /**
+     * Re-plans the light views for ctx.scene's current lights (moved, turned, new intensity;
+     * same number and types of lights) and uploads them: map sizes follow the footprint rule
+     * again, the fixed-point scales are recomputed. The photon buffer, the view buffer and the
+     * light-view maps are reused when the new plan fits them and grown (never shrunk) when it
+     * does not; returns whether anything was reallocated (then photons().buffer may have
+     * changed). Record recordPhotons (and recordSplat / recordShade) again afterwards.
+     */
+    bool refresh(TechniqueContext& ctx);
+
     /** Photons over all batches. */
     uint64_t photonCount() const { return m_plan.photonCount; }
     uint32_t viewCount() const { return uint32_t(m_plan.views.size()); }
@@ -187,6 +199,12 @@ public:
     size_t memoryBytes() const;
 
 private:
+    LightViewPlan makePlan(TechniqueContext& ctx) const;
+    void computeScales();
+    void allocatePhotons(TechniqueContext& ctx, uint64_t photons);
+    void allocateViews(TechniqueContext& ctx, size_t views);
+    void allocateMaps(TechniqueContext& ctx, uint32_t width, uint32_t height, uint32_t layers);
+    void writePhotonSet();
     void ensureDenseResources(TechniqueContext& ctx);
     void recordLightViews(TechniqueContext& ctx, VkCommandBuffer cmd, uint32_t batch, bool timed);
     void recordBatchSplat(TechniqueContext& ctx, VkCommandBuffer cmd, uint32_t batch, bool timed);
@@ -195,7 +213,11 @@ private:
     vk::Context& m_vk;
     const vk::GpuScene& m_scene;
     VoxelGrid m_grid;
+    uint32_t m_mapResolution = 0;
+    LightViewLimits m_limits;
     LightViewPlan m_plan;
+    uint64_t m_photonCapacity = 0;  // photons the photon buffer holds
+    size_t m_viewCapacity = 0;      // views the view buffer holds
     uint32_t m_recordedBatch = 0;
     bool m_floatAtomics = false;
     double m_fixedScale = 1.0;            // flux units per W

@@ -114,26 +114,7 @@ SparseVoxelOctree::SparseVoxelOctree(TechniqueContext& ctx, const VoxelGrid& gri
     m_floatAtomics = floatAtomics && ctx.vk.hasFloatAtomics();
     const uint32_t depthCount = m_leafDepth + 1;
 
-    // Lights as LightInjection numbers them (photon irradiance.w), and the fixed-point scale of
-    // the irradiance sums as the dense path: each light's photon E is clamped to its cap (E at
-    // v0 / 2 from a pinhole light, E_perp for directional), the caps' sum fits 2^31 units.
-    {
-        const std::vector<GpuLightView> views =
-            buildLightViews(ctx.scene, grid, ctx.shared.shadows().emitterSamples());
-        m_lightCount = views.empty() ? 1u : views.back().group.x + 1u;
-        m_irradianceCaps.assign(m_lightCount, 0.0f);
-        const double rCap = 0.5 * double(grid.voxelSize());
-        for (const GpuLightView& v : views) {
-            const double i = std::max({v.intensity.x, v.intensity.y, v.intensity.z});
-            const double cap = v.positionKind.w > 0.5f ? i : i / (rCap * rCap);
-            float& c = m_irradianceCaps[v.group.x];
-            c = float(std::max(double(c), cap));
-        }
-        double bound = 0.0;
-        for (float c : m_irradianceCaps)
-            bound += double(c);
-        if (bound > 0.0) m_fixedScale = 2.0e9 / bound;
-    }
+    updateLights(ctx);
 
     // Pool sizing from the CPU occupancy pyramid (same rule as svo_occupancy_up.comp).
     std::vector<std::vector<uint8_t>> occ(depthCount);
@@ -487,6 +468,32 @@ void SparseVoxelOctree::inject(TechniqueContext& ctx, VkCommandBuffer cmd,
         PassScope pass(ctx, cmd, "svo_filter");
         filterUp(cmd, kRadiance);
     }
+}
+
+void SparseVoxelOctree::updateLights(TechniqueContext& ctx) {
+    // Lights as LightInjection numbers them (photon irradiance.w), and the fixed-point scale of
+    // the irradiance sums as the dense path: each light's photon E is clamped to its cap (E at
+    // v0 / 2 from a pinhole light, E_perp for directional), the caps' sum fits 2^31 units.
+    const std::vector<GpuLightView> views =
+        buildLightViews(ctx.scene, m_grid, ctx.shared.shadows().emitterSamples());
+    const uint32_t lights = views.empty() ? 1u : views.back().group.x + 1u;
+    if (m_lights.valid() && lights != m_lightCount)
+        throw Error("SparseVoxelOctree::updateLights: the number of lights changed");
+    m_lightCount = lights;
+    m_irradianceCaps.assign(m_lightCount, 0.0f);
+    const double rCap = 0.5 * double(m_grid.voxelSize());
+    for (const GpuLightView& v : views) {
+        const double i = std::max({v.intensity.x, v.intensity.y, v.intensity.z});
+        const double cap = v.positionKind.w > 0.5f ? i : i / (rCap * rCap);
+        float& c = m_irradianceCaps[v.group.x];
+        c = float(std::max(double(c), cap));
+    }
+    double bound = 0.0;
+    for (float c : m_irradianceCaps)
+        bound += double(c);
+    if (bound > 0.0) m_fixedScale = 2.0e9 / bound;
+    // The photon buffer may have been reallocated (a handle can be reused): rebind on inject
+    m_photonBuffer = VK_NULL_HANDLE;
 }
 
 void SparseVoxelOctree::addLayoutBindings(std::vector<VkDescriptorSetLayoutBinding>& out,

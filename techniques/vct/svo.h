@@ -75,6 +75,12 @@ public:
      *  range of the buffer, as LightInjection writes them): count and irradiance splat into the
      *  leaves; then border transfer, shade, filter up. */
     void inject(TechniqueContext& ctx, VkCommandBuffer cmd, const PhotonSource& photons);
+    /** The scene's lights changed (moved, turned, new intensity; same number): recomputes the
+     *  light count and the fixed-point irradiance caps from ctx.scene, and rebinds the photon
+     *  buffer on the next inject(). Call before re-injecting (VctTechnique::update). inject()
+     *  clears the irradiance accumulators and rewrites every leaf and inner radiance brick, so
+     *  nothing of the previous injection remains. */
+    void updateLights(TechniqueContext& ctx);
     /** Bindings first .. first+3: tree info (uniform buffer), node pool (storage buffer),
      *  radiance brick pool, leaf normal brick pool (combined image samplers); see
      *  shaders/vct/svo_sample.glsl. */

@@ -9,6 +9,7 @@
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/shared_passes.h"
+#include "core/scene/animation.h"
 #include "core/scene/scene.h"
 #include "core/technique/registry.h"
 #include "core/util/error.h"
@@ -45,6 +46,12 @@ std::string mib(size_t bytes) {
     char text[32];
     std::snprintf(text, sizeof(text), "%.2f MiB", double(bytes) / (1024.0 * 1024.0));
     return text;
+}
+
+/** Bytes of one mip-less 3D volume. */
+size_t volumeBytes(const vk::Image& image) {
+    const vk::ImageDesc& d = image.desc();
+    return size_t(d.width) * d.height * d.depth * vk::formatBytesPerTexel(d.format);
 }
 
 std::vector<vk::DescriptorBinding> toBindings(const std::vector<VkDescriptorSetLayoutBinding>& in) {
@@ -167,8 +174,8 @@ void VctTechnique::setup(TechniqueContext& ctx) {
              " m (paper: 512^3, 9 levels); light-view maps " + m_injection->mapSummary() + " = " +
              std::to_string(m_injection->photonCount()) + " photons");
     ctx.note(
-        "lights are static: light is injected once at set-up (the paper re-injects when the "
-        "light moves)");
+        "light is injected at set-up and re-injected (inject + filter, voxelization kept) when "
+        "a light changes, as the paper does when the light moves");
     if (m_injection->viewCount() == 0) ctx.skip("inject", "no lights and no emitter samples");
 
     if (!m_octree) {
@@ -180,21 +187,17 @@ void VctTechnique::setup(TechniqueContext& ctx) {
         m_radiance->setSurfaceNormals(m_voxelizer->volumes().normal);
         ctx.submitTimed([&](VkCommandBuffer cmd) {
             m_voxelizer->record(cmd, ctx.timer);
-            {
-                PassScope pass(ctx, cmd, "inject");
-                m_injection->recordPhotons(ctx, cmd);
-                m_injection->recordSplat(ctx, cmd, m_voxelizer->volumes().albedoOpacity);
-                m_injection->recordShade(ctx, cmd, m_voxelizer->volumes().albedoOpacity,
-                                         m_radiance->base());
-            }
-            PassScope pass(ctx, cmd, "filter");
-            m_radiance->filter(cmd);
+            recordInjection(ctx, cmd);
         });
         m_voxelizer->releaseAccumulators();
         ctx.note("dense radiance (" +
                  std::string(options.anisotropic ? "anisotropic" : "isotropic") +
                  "): " + mib(m_radiance->memoryBytes()) + "; injection scratch " +
-                 mib(m_injection->memoryBytes()));
+                 mib(m_injection->memoryBytes()) +
+                 ", kept for re-injection when a light changes, as are the voxelizer's "
+                 "albedo/opacity and normal volumes (" +
+                 mib(volumeBytes(m_voxelizer->volumes().albedoOpacity) +
+                     volumeBytes(m_voxelizer->volumes().normal)) + ")");
         ctx.note(
             "voxels store outgoing diffuse radiance (a albedo/pi E), not the paper's incoming "
             "lobe: same result for Lambertian voxels, glossy secondary bounces are lost");
@@ -215,11 +218,11 @@ void VctTechnique::setup(TechniqueContext& ctx) {
                 PassScope pass(ctx, cmd, "svo_build");
                 m_svo->build(ctx, cmd, m_voxelizer->volumes());
             }
-            PassScope pass(ctx, cmd, "inject");
-            m_injection->recordPhotons(ctx, cmd);
-            m_svo->inject(ctx, cmd, m_injection->photons());
+            recordInjection(ctx, cmd);
         });
-        m_voxelizer.reset();  // the octree holds everything the trace needs
+        // The octree holds everything the trace and a re-injection need (geometry and normal
+        // bricks, irradiance accumulators): the dense volumes go
+        m_voxelizer.reset();
         const vct::SparseVoxelOctree::Memory mem = m_svo->memory();
         const size_t dense = VoxelRadiance::memoryBytesFor(n, VoxelRadianceOptions{});
         ctx.note(std::string("octree (") + (anisotropic ? "anisotropic" : "isotropic") +
@@ -228,6 +231,10 @@ void VctTechnique::setup(TechniqueContext& ctx) {
                  std::to_string(mem.brickCount) + ", radiance " +
                  std::to_string(mem.radianceCount) + ") = " + mib(mem.total()) +
                  "; a dense anisotropic pyramid at this resolution would take " + mib(dense));
+        ctx.note("kept for re-injection when a light changes: the octree's irradiance "
+                 "accumulators and light ranges (" + mib(mem.scratchBytes) +
+                 ", octree scratch) and the photon buffer and light-view maps (" +
+                 mib(m_injection->memoryBytes()) + ")");
     }
     if (!ctx.scene.caps.hasGlossy) {
         ctx.skip("specular_cone", "scene has no glossy materials");
@@ -236,6 +243,43 @@ void VctTechnique::setup(TechniqueContext& ctx) {
     }
     if (!m_ao) ctx.skip("ao", "ao = false");
     createGather(ctx);
+}
+
+void VctTechnique::recordInjection(TechniqueContext& ctx, VkCommandBuffer cmd) {
+    if (m_octree) {
+        // Photons, then the octree's splat / transfer / shade / filter up (svo_* nested here)
+        PassScope pass(ctx, cmd, "inject");
+        m_injection->recordPhotons(ctx, cmd);
+        m_svo->inject(ctx, cmd, m_injection->photons());
+        return;
+    }
+    vk::Image& albedoOpacity = m_voxelizer->volumes().albedoOpacity;
+    {
+        PassScope pass(ctx, cmd, "inject");
+        m_injection->recordPhotons(ctx, cmd);
+        m_injection->recordSplat(ctx, cmd, albedoOpacity);  // clears the accumulators first
+        m_injection->recordShade(ctx, cmd, albedoOpacity, m_radiance->base());  // every voxel
+    }
+    PassScope pass(ctx, cmd, "filter");
+    m_radiance->filter(cmd);
+}
+
+UpdateKind VctTechnique::update(TechniqueContext& ctx, const SceneChanges& changes) {
+    if (changes.geometry || !m_injection) return Technique::update(ctx, changes);
+    // The cone trace reads the G-buffer and the camera every frame; only the debug view was
+    // rendered with the set-up camera
+    if (changes.camera && m_voxelView) m_voxelViewStale = true;
+    if (changes.lights.empty()) return UpdateKind::None;
+    // Light moved: the voxelization (static geometry) stays; re-plan the light views for the
+    // new lights, then re-inject and re-filter (Crassin: re-injection on light motion)
+    const bool grown = m_injection->refresh(ctx);
+    if (grown)
+        ctx.note("light-view maps / photon buffer grown for a moved light: injection scratch " +
+                 mib(m_injection->memoryBytes()));
+    if (m_svo) m_svo->updateLights(ctx);
+    if (m_injection->viewCount() == 0) return UpdateKind::None;
+    ctx.submitTimed([&](VkCommandBuffer cmd) { recordInjection(ctx, cmd); });
+    return UpdateKind::Incremental;
 }
 
 void VctTechnique::createGather(TechniqueContext& ctx) {
@@ -325,6 +369,12 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
                            glm::radians(60.0f), p.getFloat("origin_offset") * v0, 0.0f);
     g.grid = m_grid.gpu();
     m_params.upload(&g, sizeof(g));
+
+    if (m_voxelViewStale && m_voxelView) {
+        // Debug view only (untimed, as at set-up): the camera moved since it was rendered
+        m_voxelView->record(cmd, ctx.scene.camera, VoxelDebugMode::Albedo);
+        m_voxelViewStale = false;
+    }
 
     PassScope pass(ctx, cmd, "trace");
     vk::memoryBarrier(cmd);  // G-buffer and the cleared indirect layer

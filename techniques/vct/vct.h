@@ -6,8 +6,13 @@
  * Set-up (timed): "voxelize" + "voxel_resolve" (core/voxel Voxelizer), "inject" (light-view maps,
  * one photon per texel, splat, voxel shade: techniques/vct/light_injection.h), "filter"
  * (VoxelRadiance mips, anisotropic by default) — or, with storage = octree, "svo_build" and
- * "inject" into the sparse voxel octree (techniques/vct/svo.h). Lights are static, so light is
- * injected once (the paper re-injects when the light moves).
+ * "inject" into the sparse voxel octree (techniques/vct/svo.h).
+ * Update (issue 11, a light moved / turned / changed): the voxelization (static geometry) is
+ * kept; "inject" (light views re-planned for the new lights, photons, splat, shade; octree: the
+ * photons and SparseVoxelOctree::inject, which clears and rewrites all radiance) and "filter"
+ * (dense mips; the octree's directional bricks are its nested "svo_filter") run again, as the
+ * paper re-injects when a light moves. A camera change redoes nothing (the trace reads the
+ * G-buffer every frame); only the "voxels" debug view is re-rendered in the next frame.
  * Per frame: "trace", one compute pass over the G-buffer: diffuse cones, a specular cone on glossy
  * pixels, AO cones for the "ao" debug view; writes the indirect layer (one bounce).
  */
@@ -37,6 +42,7 @@ public:
     ~VctTechnique() override;
     static TechniqueInfo describe();
     void setup(TechniqueContext& ctx) override;
+    UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes) override;
     void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) override;
     std::vector<DebugView> debugViews() override;
 
@@ -47,6 +53,8 @@ public:
 
 private:
     void createGather(TechniqueContext& ctx);
+    /** Records "inject" (and, dense, "filter") for the scene's current lights. */
+    void recordInjection(TechniqueContext& ctx, VkCommandBuffer cmd);
 
     VoxelGrid m_grid;
     bool m_octree = false;
@@ -56,6 +64,7 @@ private:
     std::unique_ptr<VoxelRadiance> m_radiance;
     std::unique_ptr<vct::SparseVoxelOctree> m_svo;
     std::unique_ptr<VoxelDebugView> m_voxelView;
+    bool m_voxelViewStale = false;  // the camera moved: re-render the debug view in render()
 
     vk::Image m_aoImage;
     vk::Buffer m_params;  // GpuGatherParams, host-visible uniform

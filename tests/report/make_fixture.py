@@ -18,13 +18,19 @@ Contents (schema 1, see scripts/report/report_data.py for what the report reads)
   images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), full.png (the full
               reference) and <name>.indirect.png (reference minus emission+direct), and
               final/indirect/flip PNGs per run; the EXR files are placeholders (magic number only)
+  animated    "cornell_box#moving_light" (48x48, a light moving across the box; 9 frames, 5
+              measured): tech_a (cone_count 4 and 16, update "incremental"; the 16-cone run's
+              temporal instability is within the noise floor) and tech_b (update "full
+              rebuild"); dynamic frame, update and update-pass times, metrics.sequence (per-frame
+              errors, means, temporal and temporal_matched), frames/NNN.png and temporal.png
+              per run, references/<scene>/frames/NNN_full.png
   device      lavapipe (device.type "cpu"), as the project's own results
   no-op sweep direct sweeps shared.area_light_samples (4, 16): it changes cornell_box (area
               light) and nothing on sponza#sun (identical images and metrics)
 With --no-sweeps: every technique has one run per scene and nothing is swept, and there are no
 regions, no error bars, no final_vs_full, no metrics.direct, no full reference or reference
-indirect layers (an older runner), and the device is a GPU (for checking that those parts are left
-out or labelled accordingly).
+indirect layers (an older runner), no animated scene, and the device is a GPU (for checking that
+those parts are left out or labelled accordingly).
 The numbers are made up but consistent: more cones / voxels / steps = lower error, more time.
 """
 from __future__ import annotations
@@ -45,6 +51,13 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 SCENES = {"cornell_box": (64, 64), "sponza#sun": (96, 64)}
+# The animated scene (main fixture only): a light moving across a Cornell box.
+ANIMATED_SCENE = "cornell_box#moving_light"
+ANIMATED_SIZE = (48, 48)
+ANIMATION_FRAMES = 9
+ANIMATION_DURATION_S = 4.0
+MEASURED_FRAMES = [0, 2, 4, 6, 8]
+UPDATE_KINDS = {"tech_a": "incremental", "tech_b": "full rebuild"}
 MATCHED = {0: "emission+direct", 1: "emission+direct+bounce1",
            2: "emission+direct+bounce1+bounce2"}
 SKIPPED = {
@@ -53,6 +66,7 @@ SKIPPED = {
                     "over 85 deg)"],
     "sponza#sun": ["shared/shadow.cube: scene has no point lights (or spots with an outer cone "
                    "over 85 deg)"],
+    ANIMATED_SCENE: ["shared/shadow.2d: scene has no spot or directional lights"],
 }
 REGIONS = ("ceiling", "indirect_dominant")
 # What the runner saves for a run during which the validation layer complained.
@@ -81,6 +95,7 @@ class Spec:
     notes: list[str] = field(default_factory=list)
     validation: list[str] = field(default_factory=list)  # messages; any makes it "invalid"
     shared: dict = field(default_factory=dict)  # swept shared-pass parameters (shared.<name>)
+    update: str = ""  # the animated scene's runs: "incremental" / "full rebuild"
 
 
 def run_specs(sweeps: bool) -> list[Spec]:
@@ -108,6 +123,13 @@ def run_specs(sweeps: bool) -> list[Spec]:
                              "1.0 GiB allocation limit"))
     specs.append(Spec("cornell_box", "tech_a", {"cone_count": 64, "max_distance": 1.5}, swept_a,
                       status="invalid", validation=INVALID_MESSAGES))
+    if sweeps:  # the animated scene: two techniques, one incremental, one full rebuild
+        for n in (4, 16):
+            specs.append(Spec(ANIMATED_SCENE, "tech_a", {"cone_count": n, "max_distance": 1.5},
+                              swept_a, update=UPDATE_KINDS["tech_a"]))
+        specs.append(Spec(ANIMATED_SCENE, "tech_b", {"voxel_res": 64, "steps": 16,
+                                                     "temporal": False}, swept_b,
+                          update=UPDATE_KINDS["tech_b"]))
     for i, spec in enumerate(specs):
         spec.index = i
     return specs
@@ -237,12 +259,28 @@ def metric_set(flip: float, pixels: int, bars: bool, nonfinite: int = 0,
 # Synthetic images
 # ---------------------------------------------------------------------------------------------
 
-def reference_layers(scene: str) -> tuple[np.ndarray, np.ndarray]:
-    """(direct + emission, one bounce of indirect) as display-ready RGB in [0, 1]."""
-    w, h = SCENES[scene]
+def resolution(scene: str) -> tuple[int, int]:
+    return ANIMATED_SIZE if scene == ANIMATED_SCENE else SCENES[scene]
+
+
+def reference_layers(scene: str, t: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
+    """(direct + emission, one bounce of indirect) as display-ready RGB in [0, 1]; t in [0, 1]
+    is the animation time (the animated scene's light moves from left to right)."""
+    w, h = resolution(scene)
     y, x = np.mgrid[0:h, 0:w] / np.array([h - 1, w - 1])[:, None, None]
     img = np.full((h, w, 3), 0.72)
-    if scene == "cornell_box":
+    if scene == ANIMATED_SCENE:
+        img[x < 0.15] = (0.70, 0.12, 0.10)
+        img[x > 0.85] = (0.14, 0.55, 0.16)
+        lx = 0.25 + 0.5 * t
+        shade = 0.25 + 0.75 * np.exp(-((x - lx) ** 2 + (y * 0.6) ** 2) / 0.12)
+        direct = img * shade[..., None]
+        direct[(y < 0.07) & (np.abs(x - lx) < 0.1)] = (1.0, 0.97, 0.9)
+        bleed = np.zeros_like(img)
+        bleed[..., 0] += 0.3 * np.exp(-x / 0.2) * (1.2 - lx)
+        bleed[..., 1] += 0.3 * np.exp(-(1.0 - x) / 0.2) * (0.2 + lx)
+        bleed += 0.1 * y[..., None]
+    elif scene == "cornell_box":
         img[x < 0.18] = (0.70, 0.12, 0.10)
         img[x > 0.82] = (0.14, 0.55, 0.16)
         img[(y > 0.3) & (y < 0.8) & (x > 0.3) & (x < 0.55)] = (0.55, 0.55, 0.52)
@@ -263,17 +301,20 @@ def reference_layers(scene: str) -> tuple[np.ndarray, np.ndarray]:
     return np.clip(direct, 0, 1), np.clip(bleed, 0, 1)
 
 
-def reference_image(scene: str, bounce_count: int) -> np.ndarray:
-    direct, indirect = reference_layers(scene)
+def reference_image(scene: str, bounce_count: int, t: float = 0.0) -> np.ndarray:
+    direct, indirect = reference_layers(scene, t)
     return np.clip(direct + indirect * min(bounce_count, 1) * (1.0 + 0.25 * (bounce_count - 1)),
                    0, 1)
 
 
-def technique_images(spec: Spec, flip: float, rng: np.random.Generator
+def technique_images(spec: Spec, flip: float, rng: np.random.Generator, t: float = 0.0
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(final, indirect, FLIP error map in [0, 1])."""
-    ref = reference_image(spec.scene, bounces(spec.technique))
-    direct, indirect = reference_layers(spec.scene)
+    """(final, indirect, FLIP error map in [0, 1]) at animation time t. An incremental update
+    lags a little: its indirect light is that of an earlier moment."""
+    ref = reference_image(spec.scene, bounces(spec.technique), t)
+    direct, _ = reference_layers(spec.scene, t)
+    lag = 0.12 if spec.update == "incremental" and spec.params.get("cone_count", 0) < 16 else 0.0
+    _, indirect = reference_layers(spec.scene, max(0.0, t - lag))
     if spec.technique == "direct":  # no indirect light; the shared direct pass is a bit dark
         noisy = np.zeros_like(indirect)
         samples = spec.shared.get("area_light_samples", 16)
@@ -330,7 +371,7 @@ def direct_layer_flip(spec: Spec) -> float:
 
 
 def base_result(spec: Spec, key: str, cpu: bool) -> dict:
-    w, h = SCENES[spec.scene]
+    w, h = resolution(spec.scene)
     variant = spec.scene.partition("#")[2]
     return {
         "schema": 1, "status": spec.status, "key": key, "index": spec.index,
@@ -366,12 +407,33 @@ def timing_json(spec: Spec, rng: np.random.Generator) -> dict:
     setup = {"scene_upload": 0.55 if spec.scene == "cornell_box" else 14.0,
              "shared_passes": 50.9, "shadow_maps": 108.6, "technique": tech_setup}
     setup["total"] = sum(setup.values()) + 0.1
-    return {"policy": "docs/timing.md: warm-up discarded; median and IQR over timed frames",
-            "setup_ms": setup, "setup_gpu_passes": [{"name": "shadow_maps", "gpu_ms": 108.2}],
-            "warmup_frames": 2, "timed_frames": 5,
-            "frame_cpu_ms": summary(gpu + 0.3, rng), "frame_gpu_ms": summary(gpu, rng),
-            "passes": [{"name": n, "gpu_ms": summary(v, rng),
-                        "cpu_record_ms": summary(0.01, rng)} for n, v in passes]}
+    timing = {"policy": "docs/timing.md: warm-up discarded; median and IQR over timed frames",
+              "setup_ms": setup, "setup_gpu_passes": [{"name": "shadow_maps", "gpu_ms": 108.2}],
+              "warmup_frames": 2, "timed_frames": 5,
+              "frame_cpu_ms": summary(gpu + 0.3, rng), "frame_gpu_ms": summary(gpu, rng),
+              "passes": [{"name": n, "gpu_ms": summary(v, rng),
+                          "cpu_record_ms": summary(0.01, rng)} for n, v in passes]}
+    if spec.update:  # an animated scene: the frame after the light moved, update included
+        update = update_passes(spec)
+        cost = sum(v for _, v in update)
+        timing.update({
+            "dynamic_frame_cpu_ms": summary(gpu + cost + 0.5, rng),
+            "dynamic_frame_gpu_ms": summary(gpu + cost, rng),
+            "update_cpu_ms": summary(cost + 0.2, rng),
+            "update_passes": [{"name": n, "gpu_ms": summary(v, rng)} for n, v in update]})
+    return timing
+
+
+def update_passes(spec: Spec) -> list[tuple[str, float]]:
+    """What a moved light costs: the shadow maps always; an incremental technique re-injects
+    and propagates, a full rebuild voxelizes the whole scene again."""
+    passes = [("shadow_maps", 2.4)]
+    if spec.technique == "tech_a":
+        passes += [("tech_a/inject", 0.35), ("tech_a/propagate", 0.05 * spec.params["cone_count"])]
+    elif spec.technique == "tech_b":
+        r = spec.params["voxel_res"] / 64.0
+        passes += [("tech_b/clear", 0.2 * r ** 3), ("tech_b/voxelize", 1.5 * r ** 3 * 4.0)]
+    return passes
 
 
 def memory_json(spec: Spec) -> dict:
@@ -402,7 +464,7 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
     else:
         matched = MATCHED[bounces(spec.technique)]
         flip = flip_of(spec)
-        w, h = SCENES[spec.scene]
+        w, h = resolution(spec.scene)
         bars = sweeps and spec.scene == "cornell_box"
         final, indirect, error = technique_images(spec, flip, rng)
         write_png(os.path.join(folder, "final.png"), final)
@@ -438,6 +500,10 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
                 "indirect_full_png": f"../../references/{label}/{FULL}.indirect.png"})
         with open(os.path.join(folder, "output.exr"), "wb") as f:
             f.write(EXR_MAGIC)
+        outputs = {"exr": "output.exr", "final_png": "final.png",
+                   "indirect_png": "indirect.png", "flip_png": "flip.png"}
+        if spec.update:
+            write_animation(folder, spec, rng, metrics, reference, outputs, result)
         result.update({
             "reference": reference,
             "timing": timing_json(spec, rng), "memory": memory_json(spec), "metrics": metrics,
@@ -445,14 +511,86 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
                                   "inf_pixels": 0, "negative_pixels": 0}
                           for layer in ("final", "indirect", "direct")},
             "validation": validation_json(spec.validation),
-            "outputs": {"exr": "output.exr", "final_png": "final.png",
-                        "indirect_png": "indirect.png", "flip_png": "flip.png"}})
+            "outputs": outputs})
     with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
         json.dump(result, f, indent=2)
 
 
 FULL = "full"
 FULL_BOUNCES = 3  # the fixture's "all light paths"
+
+
+def frame_time(index: int) -> float:
+    """Animation time (s) of frame `index` (frames evenly spaced over the duration)."""
+    return ANIMATION_DURATION_S * index / (ANIMATION_FRAMES - 1)
+
+
+def temporal_json(instability: float, floor: float, p95: float, pixels: int) -> dict:
+    """A temporal-instability block as toJson(TemporalResult) writes it (docs/metrics.md)."""
+    n = len(MEASURED_FRAMES)
+    level = 0.31
+    return {"frames": n, "pairs": n - 1, "region_pixels": pixels, "samples": pixels * (n - 1),
+            "skipped_pixels": 0, "level": level, "mean_abs": instability * level,
+            "temporal_instability": instability, "p95": p95, "noise_floor": floor,
+            "debiased": max(0.0, instability - floor), "note": ""}
+
+
+def write_animation(folder: str, spec: Spec, rng: np.random.Generator, metrics: dict,
+                    reference: dict, outputs: dict, result: dict) -> None:
+    """What an animated scene's run adds: the animation block, the measured frames (PNGs and
+    per-frame errors), their means and the temporal instability. tech_a with 4 cones lags
+    behind the light (error grows, unstable); with 16 cones it is within the noise floor;
+    tech_b rebuilds everything every frame (stable, costly)."""
+    w, h = resolution(spec.scene)
+    label = safe_label(spec.scene)
+    frames, names = [], []
+    for index in MEASURED_FRAMES:
+        t = index / (ANIMATION_FRAMES - 1)
+        drift = 0.04 * t if spec.update == "incremental" and spec.params["cone_count"] < 16             else 0.005 * math.sin(3.0 * t)
+        flip_full = flip_vs_full(spec) + drift
+        flip_matched = flip_of(spec) + drift
+        final, _, _ = technique_images(spec, flip_of(spec), rng, t)
+        name = f"frames/{index:03d}.png"
+        write_png(os.path.join(folder, name), final)
+        names.append(name)
+        frames.append({"frame": index, "time_s": frame_time(index),
+                       "final_vs_full": metric_set(flip_full, w * h, False, flip_resampled=False),
+                       "final": metric_set(flip_matched, w * h, False)})
+    temporal_map = np.clip(np.abs(rng.normal(0.0, 0.15, (h, w))) +
+                           (0.3 if spec.params.get("cone_count") == 4 else 0.0), 0, 1)
+    write_png(os.path.join(folder, "temporal.png"), temporal_map, cmap="magma")
+    instability = {("tech_a", 4): (0.034, 0.004, 0.12), ("tech_a", 16): (0.0036, 0.004, 0.011),
+                   ("tech_b", None): (0.015, 0.004, 0.05)}[
+        (spec.technique, spec.params.get("cone_count"))]
+    matched = (instability[0] * 0.8, instability[1], instability[2] * 0.9)
+    metrics["sequence"] = {
+        "frames": frames,
+        "full_flip_mean": sum(f["final_vs_full"]["flip"]["mean"] for f in frames) / len(frames),
+        "full_rel_mse_mean": sum(f["final_vs_full"]["rel_mse"] for f in frames) / len(frames),
+        "matched_flip_mean": sum(f["final"]["flip"]["mean"] for f in frames) / len(frames),
+        "temporal": temporal_json(*instability, w * h),
+        "temporal_matched": temporal_json(*matched, w * h)}
+    result["animation"] = {"frames": ANIMATION_FRAMES, "duration_s": ANIMATION_DURATION_S,
+                           "measured_frames": list(MEASURED_FRAMES), "update": spec.update}
+    outputs.update({"frames_png": names, "temporal_png": "temporal.png"})
+    reference["frames_png"] = [f"../../references/{label}/frames/{i:03d}_full.png"
+                               for i in MEASURED_FRAMES]
+
+
+def write_animated_references(root: str) -> None:
+    """The animated scene's references: frame 0's (as a static scene's) and every measured
+    frame's full reference."""
+    folder = os.path.join(root, "references", safe_label(ANIMATED_SCENE))
+    direct = reference_image(ANIMATED_SCENE, 0)
+    for count, name in list(MATCHED.items()) + [(FULL_BOUNCES, FULL)]:
+        image = reference_image(ANIMATED_SCENE, count)
+        write_png(os.path.join(folder, f"{name}.png"), image)
+        with open(os.path.join(folder, f"{name}.exr"), "wb") as f:
+            f.write(EXR_MAGIC)
+        write_png(os.path.join(folder, f"{name}.indirect.png"), np.clip(image - direct, 0, 1))
+    for index in MEASURED_FRAMES:
+        image = reference_image(ANIMATED_SCENE, FULL_BOUNCES, index / (ANIMATION_FRAMES - 1))
+        write_png(os.path.join(folder, "frames", f"{index:03d}_full.png"), image)
 
 
 def write_references(root: str, sweeps: bool) -> None:
@@ -508,6 +646,8 @@ def write_fixture(root: str, sweeps: bool = True) -> list[Spec]:
     specs = run_specs(sweeps)
     os.makedirs(os.path.join(root, "runs"), exist_ok=True)
     write_references(root, sweeps)
+    if any(spec.update for spec in specs):
+        write_animated_references(root)
     for spec in specs:
         write_run(root, spec, sweeps, rng)
     write_extras(root, specs, sweeps)

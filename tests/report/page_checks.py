@@ -14,7 +14,9 @@ import re
 from typing import Any, Optional
 
 LAVAPIPE = "lavapipe (CPU)"
-BASIS_WORDS = {"full": "vs full reference", "matched": "vs bounce-matched reference ("}
+BASIS_WORDS = {"full": "vs full reference", "matched": "vs bounce-matched reference (",
+               "sequence": "vs full reference, mean over the 5 measured frames"}
+DYNAMIC = "dynamic frame (light/camera moved, update included)"
 MS_WORD = re.compile(r"\bms\b")
 
 
@@ -41,8 +43,21 @@ def dig(data: Any, *path: str) -> Any:
 
 
 def basis_value(data: dict, basis: str) -> Optional[float]:
+    if basis == "sequence":
+        return dig(data, "metrics", "sequence", "full_flip_mean")
     metric = "final_vs_full" if basis == "full" else "final"
     return dig(data, "metrics", metric, "flip", "mean")
+
+
+def animated_scenes(runs: dict[str, dict]) -> set[str]:
+    """Scene labels with at least one animated run (an `animation` block)."""
+    return {dig(d, "scene", "label") for d in runs.values() if isinstance(d.get("animation"), dict)}
+
+
+def ranked_time(data: dict, animated: bool) -> Optional[float]:
+    """The frame time a ranking uses: the dynamic frame on an animated scene."""
+    name = "dynamic_frame_gpu_ms" if animated else "frame_gpu_ms"
+    return dig(data, "timing", name, "median")
 
 
 def close(a: Optional[float], b: Optional[float]) -> bool:
@@ -70,43 +85,56 @@ def ranking_tables(dom: str) -> list[tuple[str, str, str]]:
 
 
 def check_bases(checks: Any, results_dir: str, dom: str, basis: str) -> None:
-    """Every headline label names the basis; every ranking number comes from that basis; the
-    best card is the lowest on it; no table mixes references."""
+    """Every headline label names the basis (`basis` on static scenes, the mean over the measured
+    frames on animated ones); every ranking number comes from that basis (times: the dynamic
+    frame on animated scenes); the best card is the lowest on it; no table mixes references."""
     runs = results_by_key(results_dir)
-    word = BASIS_WORDS[basis]
+    animated = animated_scenes(runs)
+
+    def basis_of(data: dict) -> str:
+        return "sequence" if dig(data, "scene", "label") in animated else basis
+
     shown = cards(dom)
     headlines = [(key, re.search(r'<div class="headline"><span class="basis">(.*?)</span> '
                                  r'<b class="v">([0-9.]+)', part)) for key, part in shown]
-    checks.check(bool(shown) and all(m and word in html.unescape(m.group(1))
-                                     for _, m in headlines),
-                 f"{basis} basis: every image card's headline label names it ('{word}')",
-                 str([k for k, m in headlines if not m or word not in m.group(1)][:3]))
+    unnamed = [k for k, m in headlines
+               if not m or BASIS_WORDS[basis_of(runs[k])] not in html.unescape(m.group(1))
+               or (basis_of(runs[k]) != "sequence" and "mean over" in m.group(1))]
+    checks.check(bool(shown) and not unnamed,
+                 f"{basis} basis: every image card's headline label names it "
+                 f"('{BASIS_WORDS[basis]}'; '{BASIS_WORDS['sequence']}' on animated scenes)",
+                 str(unnamed[:3]))
     wrong = [k for k, m in headlines if m and not close(
-        round(basis_value(runs[k], basis) or -1, 4), float(m.group(2)))]
+        round(basis_value(runs[k], basis_of(runs[k])) or -1, 4), float(m.group(2)))]
     checks.check(not wrong, f"{basis} basis: every card's headline number is the run's error "
                  "on that basis", str(wrong[:3]))
     for key, part in shown:
         if 'class="badge b-best"' not in part and "b-tie" not in part.split('card-params')[0]:
             continue
         data = runs[key]
-        rivals = [basis_value(d, basis) for d in runs.values() if d.get("status") == "ok"
+        own = basis_of(data)
+        rivals = [basis_value(d, own) for d in runs.values() if d.get("status") == "ok"
                   and dig(d, "scene", "label") == dig(data, "scene", "label")
                   and dig(d, "technique", "id") == dig(data, "technique", "id")
-                  and (basis == "full" or dig(d, "reference", "matched")
+                  and (own != "matched" or dig(d, "reference", "matched")
                        == dig(data, "reference", "matched"))]
-        if not checks.check(basis_value(data, basis) is not None
-                            and basis_value(data, basis) <= min(v for v in rivals if v is not None),
-                            f"{basis} basis: best card {key[:8]} has its technique's lowest error"):
+        if not checks.check(basis_value(data, own) is not None
+                            and basis_value(data, own) <= min(v for v in rivals if v is not None),
+                            f"{own} basis: best card {key[:8]} has its technique's lowest error"):
             break
     tables = ranking_tables(dom)
-    checks.check(bool(tables) and all(b == basis for b, _, _ in tables),
-                 f"{basis} basis: {len(tables)} ranking tables, all on it",
-                 str({b for b, _, _ in tables}))
+    wanted = {basis} | ({"sequence"} if animated else set())
+    checks.check(bool(tables) and {b for b, _, _ in tables} == wanted,
+                 f"{basis} basis: {len(tables)} ranking tables, all on it (animated scenes: on "
+                 "the mean over the measured frames)", str({b for b, _, _ in tables}))
     problems = []
     for table_basis, value, markup in tables:
+        word = BASIS_WORDS[table_basis]
         heads = " | ".join(strip_tags(h) for h in re.findall(r"<th>(.*?)</th>", markup, re.S))
         if word not in heads:
             problems.append(f"header without '{word}': {heads[:120]}")
+        if (table_basis == "sequence") != (DYNAMIC in heads):
+            problems.append(f"the dynamic frame named iff animated: {heads[:160]}")
         cells = re.findall(r'data-key="([^"]+)" data-basis="([^"]+)" data-v="([^"]+)"', markup)
         if not cells:
             problems.append("table without ranked cells")
@@ -115,13 +143,15 @@ def check_bases(checks: Any, results_dir: str, dom: str, basis: str) -> None:
             data = runs[key]
             references.add(dig(data, "reference", "matched"))
             expected = (basis_value(data, table_basis) if value == "error"
-                        else dig(data, "timing", "frame_gpu_ms", "median"))
-            if cell_basis != table_basis or not close(float(v), expected):
+                        else ranked_time(data, table_basis == "sequence"))
+            if cell_basis != table_basis or basis_of(data) != table_basis \
+                    or not close(float(v), expected):
                 problems.append(f"{key[:8]}: {cell_basis} {v} != {expected}")
         if table_basis == "matched" and len(references) > 1:
             problems.append(f"one table mixes the references {sorted(references)}")
-    checks.check(not problems, f"{basis} basis: every ranked number is the run's {basis}-basis "
-                 "value (or its frame time) and no table mixes references", "; ".join(problems[:4]))
+    checks.check(not problems, f"{basis} basis: every ranked number is the run's value on its "
+                 "scene's basis (or its frame time: the dynamic frame on animated scenes) and no "
+                 "table mixes references", "; ".join(problems[:4]))
 
 
 def check_images(checks: Any, results_dir: str, dom: str) -> None:
@@ -236,3 +266,173 @@ def check_overhead(checks: Any, dom: str, measurable: bool) -> None:
     else:
         checks.check("not measurable" in body and "0.010" not in body,
                      "timer overhead within its IQR: no figure, 'not measurable'", body)
+
+
+# ---------------------------------------------------------------------------------------------
+# Animated scenes (issue 11)
+# ---------------------------------------------------------------------------------------------
+
+def _section(dom: str, start: str, end: str) -> str:
+    a = dom.find(start)
+    if a < 0:
+        return ""
+    b = dom.find(end, a + len(start))
+    return dom[a:b if b >= 0 else len(dom)]
+
+
+def _attrs(tag: str) -> dict[str, str]:
+    return {k: html.unescape(v) for k, v in re.findall(r'([\w-]+)="([^"]*)"', tag)}
+
+
+def check_animation(checks: Any, results_dir: str, dom: str) -> None:
+    """The animated-scene section exists exactly when a run is animated; on it: labels naming
+    the basis and the dynamic frame, the cost table (static and dynamic columns, device in every
+    time header, the numbers of result.json), the per-frame error figure (one line per run), the
+    temporal-instability figure, the frame strip (reference + runs, the right number of images,
+    the temporal map), "full rebuild" flagged and the within-noise-floor run marked."""
+    runs = results_by_key(results_dir)
+    scenes = animated_scenes(runs)
+    fig_dir = os.path.join(results_dir, "figures")
+    svgs = sorted(os.listdir(fig_dir)) if os.path.isdir(fig_dir) else []
+    present = 'id="animation"' in dom
+    checks.check(present == bool(scenes), f"the animated-scene section is there exactly when a "
+                 f"run is animated ({len(scenes)} animated scene(s))")
+    if not scenes:
+        checks.check(not any(s.startswith(("sequence_", "temporal_")) for s in svgs)
+                     and DYNAMIC not in dom and "mean over the" not in dom,
+                     "no animated run: no per-frame or temporal figure, no dynamic-frame or "
+                     "frame-mean label")
+        return
+    device = LAVAPIPE
+    for scene in sorted(scenes):
+        measured = {k: d for k, d in runs.items() if dig(d, "scene", "label") == scene
+                    and d.get("status") in ("ok", "nonfinite")}
+        slug_part = re.sub(r"[^A-Za-z0-9_.-]+", "_", scene)
+        block = _section(dom, f'<section class="scene anim" id="anim-{slug_part}', "</section>")
+        if not checks.check(bool(block), f"{scene}: its animated-scene block exists"):
+            continue
+        text = strip_tags(block)
+        checks.check(f"Ranked by HDR-FLIP {BASIS_WORDS['sequence']}" in text and DYNAMIC in text,
+                     f"{scene}: the block names the basis and the dynamic frame")
+        # the scene's image cards: headline on the frame mean, time on the dynamic frame
+        own_cards = [(k, p.split('class="card-links"')[0]) for k, p in cards(dom)
+                     if k in measured]
+        checks.check(bool(own_cards) and all(
+            BASIS_WORDS["sequence"] in strip_tags(p) and DYNAMIC in strip_tags(p) and "static frame time" in strip_tags(p)
+            for _, p in own_cards),
+            f"{scene}: every image card names the frame-mean basis, the dynamic and the static "
+            "frame")
+        # the error-vs-time figure: dynamic frame on its time axes, basis in the first title
+        pareto = [s for s in svgs if s.startswith(f"pareto_{slug_part}")]
+        texts = svg_texts(os.path.join(fig_dir, pareto[0])) if pareto else []
+        joined = " ".join(texts)
+        checks.check(bool(pareto) and "dynamic frame" in joined
+                     and "(light/camera moved, update included)" in joined
+                     and "static frame of the same run" in joined
+                     and next((t for t in texts if t.startswith("HDR-FLIP vs")), "")
+                     .startswith("HDR-FLIP vs full reference, mean over the 5"),
+                     f"{scene}: the error-vs-time figure is on the dynamic frame (static frame "
+                     "shown too) and its first panel on the frame mean")
+        check_cost_table(checks, scene, block, measured, device)
+        check_animation_figures(checks, scene, block, fig_dir, slug_part, measured)
+        check_strip(checks, scene, block, measured)
+        rebuilt = [k for k, d in measured.items() if dig(d, "animation", "update") == "full rebuild"]
+        flagged = [k for k, p in own_cards if 'class="badge b-rebuild" data-update="full rebuild"'
+                   in p and "no real update path" in p]
+        incremental = [k for k, p in own_cards if "b-rebuild" in p
+                       and dig(runs[k], "animation", "update") != "full rebuild"]
+        checks.check(bool(rebuilt) and set(flagged) == {k for k, _ in own_cards if k in rebuilt}
+                     and not incremental and 'class="warn rebuild"' in block,
+                     f"{scene}: \"full rebuild\" is flagged (badge on its cards and rows, a "
+                     "warning in the block), \"incremental\" is not")
+        quiet = [k for k, d in measured.items()
+                 if (dig(d, "metrics", "sequence", "temporal", "temporal_instability") or 1.0)
+                 <= (dig(d, "metrics", "sequence", "temporal", "noise_floor") or 0.0)]
+        rows = {k: r for k, r in re.findall(r'<tr data-key="([^"]+)">(.*?)</tr>',
+                                            _section(block, 'class="data sequence-errors"',
+                                                     "</table>"), re.S)}
+        checks.check(bool(quiet) and all("no measurable instability" in rows.get(k, "")
+                                         for k in quiet)
+                     and sum("no measurable instability" in r for r in rows.values()) == len(quiet),
+                     f"{scene}: the run within the noise floor is marked 'no measurable "
+                     "instability', and only it")
+
+
+def check_cost_table(checks: Any, scene: str, block: str, measured: dict[str, dict],
+                     device: str) -> None:
+    table = _section(block, '<table class="data cost"', "</table>")
+    heads = [strip_tags(h) for h in re.findall(r"<th>(.*?)</th>", table, re.S)]
+    timed = [h for h in heads if ", ms" in h]
+    checks.check(any(h.startswith("static frame time") for h in heads)
+                 and any(DYNAMIC in h for h in heads)
+                 and any(h.startswith("update (CPU clock)") for h in heads)
+                 and len(timed) >= 4 and all(device in h for h in timed),
+                 f"{scene}: the cost table has static frame, dynamic frame, update and update "
+                 f"pass columns, every time header naming '{device}'", str(heads))
+    rows = dict(re.findall(r'<tr data-key="([^"]+)">(.*?)</tr>', table, re.S))
+    problems = [] if set(rows) == set(measured) else [f"rows {len(rows)} != {len(measured)}"]
+    for key, row in rows.items():
+        data = measured.get(key, {})
+        cells = dict(re.findall(r'data-col="(static|dynamic|update)" data-v="([^"]*)"', row))
+        for col, path in (("static", ("timing", "frame_gpu_ms", "median")),
+                          ("dynamic", ("timing", "dynamic_frame_gpu_ms", "median")),
+                          ("update", ("timing", "update_cpu_ms", "median"))):
+            if not cells.get(col) or not close(float(cells[col]), dig(data, *path)):
+                problems.append(f"{key[:8]} {col}: {cells.get(col)} != {dig(data, *path)}")
+        passes = re.findall(r'data-col="pass" data-v="([^"]*)"', row)
+        expected = sorted(dig(p, "gpu_ms", "median") for p in dig(data, "timing",
+                                                                  "update_passes") or [])
+        if sorted(float(v) for v in passes if v) != expected:
+            problems.append(f"{key[:8]} passes {passes} != {expected}")
+    checks.check(not problems, f"{scene}: one cost-table row per run with its static, dynamic, "
+                 "update and update-pass medians from result.json", "; ".join(problems[:4]))
+
+
+def check_animation_figures(checks: Any, scene: str, block: str, fig_dir: str, slug_part: str,
+                            measured: dict[str, dict]) -> None:
+    svgs = os.listdir(fig_dir)
+    sequence = [s for s in svgs if s.startswith(f"sequence_{slug_part}")]
+    temporal = [s for s in svgs if s.startswith(f"temporal_{slug_part}")]
+    with_frames = {k for k, d in measured.items() if dig(d, "metrics", "sequence", "frames")}
+    lines: list[str] = []
+    if sequence:
+        with open(os.path.join(fig_dir, sequence[0]), encoding="utf-8") as f:
+            lines = re.findall(r'id="seq-line-full-([0-9a-f]+)"', f.read())
+    checks.check(len(sequence) == 1 and f"figures/{sequence[0]}" in block
+                 and sorted(lines) == sorted(with_frames),
+                 f"{scene}: the per-frame error figure is shown, with one line per run "
+                 f"({len(lines)} lines, {len(with_frames)} runs)")
+    bars: list[str] = []
+    if temporal:
+        with open(os.path.join(fig_dir, temporal[0]), encoding="utf-8") as f:
+            bars = re.findall(r'id="temporal-bar-([0-9a-f]+)"', f.read())
+    caption = strip_tags(_section(block, f"figures/{temporal[0]}" if temporal else "\0",
+                                  "</figure>"))
+    checks.check(len(temporal) == 1 and sorted(bars) == sorted(measured)
+                 and "Temporal instability" in caption and "noise floor" in caption
+                 and "no measurable instability" in caption,
+                 f"{scene}: the temporal-instability figure is shown (one bar per run), its "
+                 "caption defines it and says what the noise floor means")
+
+
+def check_strip(checks: Any, scene: str, block: str, measured: dict[str, dict]) -> None:
+    strip = _section(block, '<table class="strip"', "</table>")
+    rows = re.findall(r'<tr class="(strip-ref|strip-run)"([^>]*)>(.*?)</tr>', strip, re.S)
+    refs = [r for r in rows if r[0] == "strip-ref"]
+    run_rows = {_attrs(r[1]).get("data-key"): r[2] for r in rows if r[0] == "strip-run"}
+    n_refs = {len(dig(d, "reference", "frames_png") or []) for d in measured.values()}
+    problems = []
+    if len(refs) != 1 or len(re.findall(r"<img ", refs[0][2])) != max(n_refs):
+        problems.append(f"reference rows {len(refs)}")
+    if set(run_rows) != set(measured):
+        problems.append(f"run rows {sorted(run_rows)}")
+    for key, row in run_rows.items():
+        data = measured.get(key, {})
+        srcs = re.findall(r'<img src="([^"]+)"', row)
+        frames = [s for s in srcs if "/frames/" in s]
+        want = [f"runs/{key}/{p}" for p in dig(data, "outputs", "frames_png") or []]
+        if frames != want or srcs[-1:] != [f"runs/{key}/{dig(data, 'outputs', 'temporal_png')}"]:
+            problems.append(f"{key[:8]}: {srcs}")
+    checks.check(not problems and bool(run_rows), f"{scene}: the frame strip has the reference "
+                 f"row ({max(n_refs)} frames) and one row per run ({len(run_rows)}) with its "
+                 "frames in order and its temporal map last", "; ".join(problems[:3]))

@@ -40,7 +40,9 @@ PYTHON = "/usr/bin/python3"
 CHROMIUM = "/usr/bin/chromium"
 SKIP = 77
 CONSOLE_LINE = re.compile(r"CONSOLE[:(]|Uncaught")
-SECTIONS = ("images", "runs", "pareto", "sweeps", "passes", "equal", "skipped", "unreadable")
+SECTIONS = ("images", "animation", "runs", "pareto", "sweeps", "passes", "equal", "skipped",
+            "unreadable")
+ANIMATED_SLUG = "cornell_box_moving_light"  # the fixture's animated scene, in file names
 
 
 # ---------------------------------------------------------------------------------------------
@@ -231,10 +233,16 @@ def check_main(checks: Checks, tmp: str) -> None:
     first_titles = {s: next((t for t in page_checks.svg_texts(os.path.join(fixture, "figures", s))
                              if t.startswith("HDR-FLIP vs")), "") for s in svgs
                     if s.startswith(("pareto_", "sweep_"))}
-    checks.check(all(t == "HDR-FLIP vs full reference" for t in first_titles.values()),
+
+    def right_title(name: str, title: str) -> bool:  # animated: the mean over the frames
+        if ANIMATED_SLUG in name:
+            return title.startswith("HDR-FLIP vs full reference, mean over the 5 measured")
+        return title == "HDR-FLIP vs full reference"
+    checks.check(all(right_title(k, t) for k, t in first_titles.items())
+                 and any(ANIMATED_SLUG in k for k in first_titles),
                  "the first panel of every error-vs-time and sweep figure is HDR-FLIP vs full "
-                 "reference", str({k: v for k, v in first_titles.items()
-                                   if v != "HDR-FLIP vs full reference"}))
+                 "reference (on the animated scene: its mean over the measured frames)",
+                 str({k: v for k, v in first_titles.items() if not right_title(k, v)}))
     page_checks.check_bases(checks, fixture, dom, "full")
     page_checks.check_images(checks, fixture, dom)
     page_checks.check_device(checks, fixture, dom, page_checks.LAVAPIPE)
@@ -243,6 +251,7 @@ def check_main(checks: Checks, tmp: str) -> None:
     page_checks.check_iqr_bars(checks, fixture)
     page_checks.check_ties(checks, dom)
     page_checks.check_overhead(checks, dom, measurable=True)
+    page_checks.check_animation(checks, fixture, dom)
     checks.check("256^3 voxel grid needs 2.0 GiB" in dom, "the unsupported run's reason is shown")
     checks.check("0badc0ffee0badc0" in dom and "unreadable" in dom,
                  "the malformed run folder is listed as unreadable with its path")
@@ -257,7 +266,8 @@ def check_main(checks: Checks, tmp: str) -> None:
                  str(cols))
     checks.check(pareto_rows(fixture) == {"matched", "one_bounce", "full"},
                  "error-vs-time figures have a matched, a one-bounce and a full-reference row")
-    sweep_svgs = [s for s in svgs if s.startswith("sweep_tech_a_")]
+    sweep_svgs = [s for s in svgs if s.startswith("sweep_tech_a_")
+                  and ANIMATED_SLUG not in s]  # no direct run on the animated scene
     checks.check(bool(sweep_svgs) and all(
         "direct (same reference)" in open(os.path.join(fixture, "figures", s),
                                           encoding="utf-8").read() for s in sweep_svgs),
@@ -271,8 +281,8 @@ def check_main(checks: Checks, tmp: str) -> None:
     check_invalid(checks, fixture, dom, items)
     refs = {a["src"].split("/")[1] for tag, a in items
             if tag == "img" and a.get("src", "").startswith("references/")}
-    checks.check(refs == {"cornell_box", "sponza_sun"}, "reference images of both scenes shown",
-                 str(refs))
+    checks.check(refs == {"cornell_box", "sponza_sun", ANIMATED_SLUG},
+                 "reference images of all three scenes shown", str(refs))
 
     screenshot(checks, tmp, page, "fixture page")
 
@@ -352,6 +362,7 @@ def check_no_sweeps(checks: Checks, tmp: str) -> None:
     page_checks.check_bases(checks, fixture, dom, "matched")
     page_checks.check_device(checks, fixture, dom, "GPU")
     page_checks.check_overhead(checks, dom, measurable=False)
+    page_checks.check_animation(checks, fixture, dom)
     checks.check("the full reference image and the reference indirect layers are not recorded"
                  in dom and "/full.png" not in dom,
                  "no-sweep fixture (older runner): no full reference image, and the page says so")
@@ -400,6 +411,23 @@ HOSTILE_RUNS = {
         "r": None}}, "reference": {"final_png": None}},
     "unknown_status": {"status": "running"},
     "invalid_odd": {"status": "invalid", "validation": {"errors": "x", "messages": [None, 5]}},
+    # animated scenes (issue 11): every new key wrong or missing
+    "anim_odd": {"status": "ok", "scene": {"label": "a"}, "technique": {"id": "t"},
+                 "animation": {"frames": "x", "duration_s": None, "measured_frames": [None, "a", 2],
+                               "update": 5},
+                 "timing": {"dynamic_frame_gpu_ms": {"median": None}, "update_cpu_ms": "x",
+                            "update_passes": [None, {"name": None, "gpu_ms": 3}]},
+                 "metrics": {"sequence": {"frames": [None, {"frame": "x", "final_vs_full": None},
+                                                     {"frame": 2, "time_s": "y", "final": [1]}],
+                                          "full_flip_mean": "bad", "temporal": {
+                                              "temporal_instability": "bad", "note": 5},
+                                          "temporal_matched": []}},
+                 "outputs": {"frames_png": [None, 5, "missing.png"], "temporal_png": 7},
+                 "reference": {"frames_png": "not a list"}},
+    "anim_partial": {"status": "nonfinite", "scene": {"label": "a"}, "technique": {"id": "u"},
+                     "animation": {"update": "none"}, "metrics": {"sequence": None},
+                     "timing": {"frame_gpu_ms": {"median": 2.0},
+                                "dynamic_frame_cpu_ms": {"median": 3.0}}},
 }
 
 
@@ -421,8 +449,10 @@ def check_hostile(checks: Checks, tmp: str) -> None:
     if not os.path.isfile(page):
         return
     dom = load_dom(checks, tmp, page, "hostile page")
-    checks.check(run_rows(elements(dom)) == 4 and dom.count("st-unreadable") >= 4,
-                 "hostile values: 4 runs shown, 3 folders listed as unreadable")
+    checks.check(run_rows(elements(dom)) == 6 and dom.count("st-unreadable") >= 4,
+                 "hostile values: 6 runs shown, 3 folders listed as unreadable")
+    checks.check('id="animation"' in dom and "update: none" in dom,
+                 "hostile values: the odd animated runs get an animated-scene block")
 
 
 def check_edges(checks: Checks, tmp: str) -> None:
