@@ -299,20 +299,19 @@ TEST_F(GpuDynamic, DvsRelightsAndRefilters) {
 }
 
 TEST_F(GpuDynamic, DvsTwoBouncesRegathers) {
-    checkMoveAndReturn(*m_ctx, {"dvs",
-                                {{"voxel_resolution", "32"}, {"bounces", "2"}},
-                                UpdateKind::Incremental,
-                                {"dvs/voxel_direct", "dvs/filter", "dvs/voxel_bounce",
-                                 "dvs/filter2"}});
+    checkMoveAndReturn(*m_ctx,
+                       {"dvs",
+                        {{"voxel_resolution", "32"}, {"bounces", "2"}},
+                        UpdateKind::Incremental,
+                        {"dvs/voxel_direct", "dvs/filter", "dvs/voxel_bounce", "dvs/filter2"}});
 }
 
 // Timing only (run with --gtest_also_run_disabled_tests): the same checks at N = 64.
 TEST_F(GpuDynamic, DISABLED_UpdateTimesAt64) {
     checkMoveAndReturn(*m_ctx, {"vct", {{"voxel_resolution", "64"}}, UpdateKind::Incremental, {}});
-    checkMoveAndReturn(*m_ctx, {"vct",
-                                {{"voxel_resolution", "64"}, {"storage", "octree"}},
-                                UpdateKind::Incremental,
-                                {}});
+    checkMoveAndReturn(
+        *m_ctx,
+        {"vct", {{"voxel_resolution", "64"}, {"storage", "octree"}}, UpdateKind::Incremental, {}});
     checkMoveAndReturn(*m_ctx, {"dvs", {{"voxel_resolution", "64"}}, UpdateKind::Incremental, {}});
 }
 

@@ -51,9 +51,6 @@ public:
         }
         for (const std::string& w : scene->warnings)
             std::fprintf(stderr, "gilab: %s: warning: %s\n", entry.label.c_str(), w.c_str());
-        // An animated scene starts at frame 0 of its animation (its static frames, set-up and
-        // references are those of frame 0).
-        if (scene->animation.animated()) applyFrameState(*scene, frameState(*scene, 0));
         return *m_scenes.emplace(entry.label, std::move(scene)).first->second;
     }
 

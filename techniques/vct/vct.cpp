@@ -197,7 +197,8 @@ void VctTechnique::setup(TechniqueContext& ctx) {
                  ", kept for re-injection when a light changes, as are the voxelizer's "
                  "albedo/opacity and normal volumes (" +
                  mib(volumeBytes(m_voxelizer->volumes().albedoOpacity) +
-                     volumeBytes(m_voxelizer->volumes().normal)) + ")");
+                     volumeBytes(m_voxelizer->volumes().normal)) +
+                 ")");
         ctx.note(
             "voxels store outgoing diffuse radiance (a albedo/pi E), not the paper's incoming "
             "lobe: same result for Lambertian voxels, glossy secondary bounces are lost");
@@ -231,10 +232,11 @@ void VctTechnique::setup(TechniqueContext& ctx) {
                  std::to_string(mem.brickCount) + ", radiance " +
                  std::to_string(mem.radianceCount) + ") = " + mib(mem.total()) +
                  "; a dense anisotropic pyramid at this resolution would take " + mib(dense));
-        ctx.note("kept for re-injection when a light changes: the octree's irradiance "
-                 "accumulators and light ranges (" + mib(mem.scratchBytes) +
-                 ", octree scratch) and the photon buffer and light-view maps (" +
-                 mib(m_injection->memoryBytes()) + ")");
+        ctx.note(
+            "kept for re-injection when a light changes: the octree's scratch "
+            "(irradiance accumulators, deposit counts, light ranges, occupancy) " +
+            mib(mem.scratchBytes) + " and the photons and light-view maps " +
+            mib(m_injection->memoryBytes()) + "; the dense voxel volumes are freed");
     }
     if (!ctx.scene.caps.hasGlossy) {
         ctx.skip("specular_cone", "scene has no glossy materials");
