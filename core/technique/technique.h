@@ -154,11 +154,11 @@ public:
     virtual void onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys);
     /**
      * Called before a frame when lights, camera or geometry changed since the previous frame.
-     * ctx.scene already holds the new state, and the shared passes are updated (the GpuScene
-     * light buffer and pass light table now; the moved lights' shadow maps are re-rendered at
-     * the start of this frame, before render(), so update work that reads them belongs in
-     * render() or in submissions made after ctx.shared.recordShadowUpdates()). Record update
-     * passes with ctx.submitTimed + PassScope (their GPU times count as this frame's update).
+     * ctx.scene already holds the new state, and the shared passes are updated: the GpuScene
+     * light buffer, the pass light table and the moved lights' shadow maps (re-rendered in a
+     * finished submission before update() is called, so update passes may read them). Record
+     * update passes with ctx.submitTimed + PassScope (their GPU times count as this frame's
+     * update).
      * Default: setup() again when anything changed (FullRebuild), else None.
      */
     virtual UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes);
