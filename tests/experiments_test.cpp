@@ -10,13 +10,15 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "core/util/error.h"
 #include "core/scene/animation.h"
 #include "core/scene/scene_loader.h"
-#include "reference/scene_hash.h"
+#include "core/technique/frame_harness.h"
+#include "core/util/error.h"
+#include "experiments/cli/run_metadata.h"
 #include "experiments/runner/experiment_config.h"
 #include "experiments/runner/run_store.h"
 #include "experiments/runner/runner.h"
+#include "reference/scene_hash.h"
 
 namespace gilab::exp {
 namespace {
@@ -239,6 +241,27 @@ TEST(CpuRunner, DryRunPrintsTheParameterColumnsOfTheResultTables) {
     fs::remove_all(dir);
 }
 
+TEST(CpuTiming, DynamicFramesSumTopLevelPassesOnly) {
+    FrameTiming t;
+    t.dynamic = true;
+    t.cpuMs = 10.0;
+    t.updateCpuMs = 4.0;
+    t.passes = {{"gbuffer", 1.0, 0.0}, {"x/trace", 2.0, 0.0}};
+    // A nested pass ("x/inject.splat" inside "x/inject") is not counted twice; a name with a
+    // dot but no parent in the list ("shadow_maps.update") is a pass of its own.
+    t.updatePasses = {{"shadow_maps.update", 0.5, 0.0},
+                      {"x/inject", 3.0, 0.0},
+                      {"x/inject.splat", 2.5, 0.0},
+                      {"x/filter", 0.25, 0.0}};
+    const nlohmann::ordered_json j = cli::dynamicTimingJson({t, FrameTiming{}});
+    EXPECT_EQ(j["dynamic_frames"], 1);  // the static frame is not a dynamic one
+    EXPECT_DOUBLE_EQ(j["dynamic_frame_gpu_ms"]["median"].get<double>(),
+                     1.0 + 2.0 + 0.5 + 3.0 + 0.25);
+    EXPECT_DOUBLE_EQ(j["update_cpu_ms"]["median"].get<double>(), 4.0);
+    ASSERT_EQ(j["update_passes"].size(), 4u);
+    EXPECT_EQ(j["update_passes"][1]["name"], "x/inject");
+}
+
 class GpuRunner : public ::testing::Test {
 protected:
     void SetUp() override {
@@ -341,8 +364,8 @@ TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {
         entries += e.is_directory() && e.path().filename().string()[0] != '.' ? 1 : 0;
     // Distinct frames by their reference key (the spot returns to its start: frame 8 = 0).
     auto distinctKeys = [&](std::initializer_list<int> frames) {
-        Scene scene = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json",
-                                    "spot_orbit");
+        Scene scene =
+            loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", "spot_orbit");
         scene.settings.width = scene.settings.height = 16;
         const ExperimentConfig config = loadExperimentConfig(m_config);
         std::set<std::string> keys;

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <fstream>
@@ -39,6 +40,24 @@ nlohmann::ordered_json vec3Json(const glm::vec3& v) {
 /** NaN is not valid JSON: a NaN measurement is written as null. */
 nlohmann::ordered_json number(double v) {
     return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
+
+/**
+ * Sum of a frame's pass times without double counting: a nested pass is named
+ * "<parent>.<child>" (e.g. "vct/inject.splat" inside "vct/inject") and is left out when its
+ * parent is in the list; "shadow_maps.update" has no parent "shadow_maps" there and counts.
+ */
+double topLevelGpuMs(const std::vector<const vk::PassTime*>& passes) {
+    double total = 0.0;
+    for (const vk::PassTime* p : passes) {
+        const size_t dot = p->name.rfind('.');
+        const bool nested = dot != std::string::npos &&
+                            std::any_of(passes.begin(), passes.end(), [&](const vk::PassTime* q) {
+                                return q->name == p->name.substr(0, dot);
+                            });
+        if (!nested) total += p->gpuMs;
+    }
+    return total;
 }
 
 nlohmann::ordered_json summaryJson(const std::vector<double>& values) {
@@ -193,9 +212,12 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
                           {"gpu_ms", summaryJson(gpu[name])},
                           {"cpu_record_ms", summaryJson(record[name])}});
     }
-    for (size_t i = 0; i < frames.size(); ++i)
+    for (size_t i = 0; i < frames.size(); ++i) {
+        std::vector<const vk::PassTime*> list;
         for (const vk::PassTime& p : frames[i].passes)
-            gpuTotal[i] += p.gpuMs;
+            list.push_back(&p);
+        gpuTotal[i] = topLevelGpuMs(list);
+    }
     return {{"policy", "docs/timing.md: warm-up discarded; median and IQR over timed frames"},
             {"setup_ms",
              {{"scene_upload", setup.sceneUploadMs},
@@ -219,11 +241,11 @@ nlohmann::ordered_json dynamicTimingJson(const std::vector<FrameTiming>& frames)
         if (!f.dynamic) continue;
         cpu.push_back(f.cpuMs);
         update.push_back(f.updateCpuMs);
-        double total = 0.0;
+        std::vector<const vk::PassTime*> all;
         for (const std::vector<vk::PassTime>* list : {&f.passes, &f.updatePasses})
             for (const vk::PassTime& p : *list)
-                total += p.gpuMs;
-        gpu.push_back(total);
+                all.push_back(&p);
+        gpu.push_back(topLevelGpuMs(all));
         // Update passes may repeat a name (one submission per light): summed per frame.
         std::map<std::string, double> perFrame;
         for (const vk::PassTime& p : f.updatePasses) {

@@ -154,6 +154,26 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
         addMetricColumns(row, prefix + ".matched", jsonAt(region, {"final"}));
         addMetricColumns(row, prefix + ".indirect", jsonAt(region, {"indirect"}));
     }
+    // Animated scenes (docs/experiments.md "Animated scenes"): the sequence and dynamic frames.
+    if (at({"animation"}).is_object()) {
+        row["animation_frames"] = at({"animation", "frames"});
+        row["update_kind"] = at({"animation", "update"});
+        row["dynamic_frame_gpu_ms_median"] = at({"timing", "dynamic_frame_gpu_ms", "median"});
+        row["dynamic_frame_gpu_ms_iqr"] = at({"timing", "dynamic_frame_gpu_ms", "iqr"});
+        row["dynamic_frame_cpu_ms_median"] = at({"timing", "dynamic_frame_cpu_ms", "median"});
+        row["update_cpu_ms_median"] = at({"timing", "update_cpu_ms", "median"});
+        row["sequence.full.flip_mean"] = at({"metrics", "sequence", "full_flip_mean"});
+        row["sequence.full.rel_mse_mean"] = at({"metrics", "sequence", "full_rel_mse_mean"});
+        row["sequence.matched.flip_mean"] = at({"metrics", "sequence", "matched_flip_mean"});
+        for (const char* basis : {"temporal", "temporal_matched"}) {
+            const std::string prefix = std::string("sequence.") + basis;
+            row[prefix + ".instability"] =
+                at({"metrics", "sequence", basis, "temporal_instability"});
+            row[prefix + ".p95"] = at({"metrics", "sequence", basis, "p95"});
+            row[prefix + ".noise_floor"] = at({"metrics", "sequence", basis, "noise_floor"});
+            row[prefix + ".debiased"] = at({"metrics", "sequence", basis, "debiased"});
+        }
+    }
     addNonFiniteColumns(row, at({"nonfinite"}));
     row["output_exr"] = at({"outputs", "exr"}).is_string()
                             ? Json("runs/" + at({"key"}).get<std::string>() + "/" +

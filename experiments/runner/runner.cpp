@@ -222,13 +222,22 @@ void printRunLine(const nlohmann::ordered_json& row, bool quiet) {
                        row.value("technique", "") + " on " + row.value("scene", "") + ": " +
                        row.value("status", "");
     char buf[160];
-    if (number("full.flip") >= 0.0) {
+    if (number("sequence.full.flip_mean") >= 0.0) {  // animated: the sequence, dynamic frames
+        std::snprintf(buf, sizeof buf,
+                      ", HDR-FLIP vs full %.3f (mean over the measured frames), temporal "
+                      "instability %.3f, dynamic frame %.2f ms (%s update)",
+                      number("sequence.full.flip_mean"), number("sequence.temporal.instability"),
+                      number("dynamic_frame_gpu_ms_median"), row.value("update_kind", "").c_str());
+        line += buf;
+    } else if (number("full.flip") >= 0.0) {
         std::snprintf(buf, sizeof buf, ", HDR-FLIP vs full %.3f, relMSE vs full %.4f",
                       number("full.flip"), number("full.rel_mse"));
         line += buf;
     }
     if (number("frame_gpu_ms_median") >= 0.0) {
-        std::snprintf(buf, sizeof buf, ", frame %.2f ms (%s)", number("frame_gpu_ms_median"),
+        std::snprintf(buf, sizeof buf, ", %s %.2f ms (%s)",
+                      number("sequence.full.flip_mean") >= 0.0 ? "static frame" : "frame",
+                      number("frame_gpu_ms_median"),
                       row.value("device_type", "") == "cpu" ? "lavapipe, CPU" : "GPU");
         line += buf;
     }

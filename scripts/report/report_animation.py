@@ -230,17 +230,12 @@ def scene_animation(scene: str, runs: list[Run], page: Page) -> str:
     basis = page.basis(scene)
     device = device_label(runs)
     rebuilt = _flagged(runs, "full rebuild")
-    stale = _flagged(runs, "none")
     flags = ""
     if rebuilt:
         names = ", ".join(ordered_unique([swatch(r.technique, page) for r in rebuilt]))
         flags += (f'<p class="warn rebuild">{names}: <b>full rebuild</b> — no real update path; '
                   "the technique rebuilds everything whenever the light or camera moves, so its "
                   "dynamic frame includes its whole set-up work.</p>")
-    if stale:
-        names = ", ".join(ordered_unique([swatch(r.technique, page) for r in stale]))
-        flags += (f'<p class="warn stale">{names}: <b>no update</b> — its indirect light stays '
-                  "that of the first frame; its error grows as the scene moves.</p>")
     described = _describe(runs)
     sequence = page.figures.sequence.get(scene)
     temporal = page.figures.temporal.get(scene)
@@ -300,4 +295,5 @@ def animation_html(page: Page) -> str:
             'it. The update kind says how a technique follows the motion: '
             '<i>incremental</i> (updates what changed), <i>full rebuild</i> (no real update '
             'path: it redoes its whole set-up every time something moves; flagged) or '
-            '<i>none</i> (stale indirect light; flagged).</p>' + body)
+            '<i>none</i> (nothing it precomputes depends on what moved, e.g. only the camera '
+            'moved).</p>' + body)

@@ -212,15 +212,16 @@ def scene_anchor(scene: str) -> str:
 
 
 # How an animated scene's run brings its global illumination up to date after the light or
-# camera moved (animation.update), as a badge; "full rebuild" and "none" are flagged.
+# camera moved (animation.update), as a badge; "full rebuild" is flagged.
 UPDATE_WORDS = {
     "incremental": ("b-update", "update: incremental",
                     "the technique updates only what the motion changed"),
     "full rebuild": ("b-rebuild", "update: full rebuild \u2014 no real update path",
                      "the technique has no real update path: it rebuilds everything whenever "
                      "the light or camera moves, so its dynamic frame pays the whole set-up"),
-    "none": ("b-stale", "update: none \u2014 stale",
-             "the technique does not update: its indirect light stays that of the first frame"),
+    "none": ("b-update", "update: none needed",
+             "nothing the technique precomputes depends on what moved (only the camera moved, "
+             "or the technique keeps no light of its own); the shared passes still updated"),
 }
 
 
