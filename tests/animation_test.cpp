@@ -3,6 +3,8 @@
 // errors, and the animated variants of scenes/cornell_box.json and scenes/sponza.json.
 #include <gtest/gtest.h>
 
+#include "tests/temp_dir.h"
+
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -39,23 +41,10 @@ void expectError(Fn&& fn, std::initializer_list<std::string> fragments) {
     }
 }
 
-class TempDir {
+/** This file's temporary folders (tests/temp_dir.h). */
+class TempDir : public test::TempDir {
 public:
-    TempDir() {
-        static std::atomic<int> counter{0};
-        m_path = fs::temp_directory_path() / ("gilab_animation_test_" + std::to_string(::getpid()) +
-                                              "_" + std::to_string(counter++));
-        fs::create_directories(m_path);
-    }
-    ~TempDir() { fs::remove_all(m_path); }
-    std::string write(const std::string& name, const std::string& text) const {
-        const std::string path = (m_path / name).string();
-        std::ofstream(path, std::ios::binary) << text;
-        return path;
-    }
-
-private:
-    fs::path m_path;
+    TempDir() : test::TempDir("gilab_animation_test") {}
 };
 
 void expectVec(const glm::vec3& a, const glm::vec3& b, float tol = 1e-6f) {

@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include "tests/temp_dir.h"
+
 #include "core/image/image_io.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/compare_command.h"
@@ -24,25 +26,10 @@ using gilab::cli::CompareResult;
 
 namespace {
 
-/** A fresh folder per test, removed afterwards. */
-class TempDir {
+/** This file's temporary folders (tests/temp_dir.h). */
+class TempDir : public test::TempDir {
 public:
-    TempDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_path = fs::temp_directory_path() / ("gilab_compare_" + std::to_string(::getpid()) + "_" +
-                                              info->test_suite_name() + "_" + info->name());
-        fs::remove_all(m_path);
-        fs::create_directories(m_path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(m_path, ec);
-    }
-    std::string file(const std::string& name) const { return (m_path / name).string(); }
-    const fs::path& path() const { return m_path; }
-
-private:
-    fs::path m_path;
+    TempDir() : test::TempDir("gilab_compare") {}
 };
 
 Image makeImage(int w, int h, const std::function<float(int, int, int)>& value) {

@@ -11,7 +11,9 @@
 #include <thread>
 
 #include <gtest/gtest.h>
+
 #include <nlohmann/json.hpp>
+#include "tests/temp_dir.h"
 
 #include "core/image/image_io.h"
 #include "core/scene/scene_loader.h"
@@ -44,24 +46,10 @@ ref::StopCriteria samplesStop(uint64_t n) {
     return ref::StopCriteria{n, 0.0, 0.0};
 }
 
-/** A fresh folder per test, removed afterwards. */
-class TempDir {
+/** This file's temporary folders (tests/temp_dir.h). */
+class TempDir : public test::TempDir {
 public:
-    TempDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        m_path = fs::temp_directory_path() / ("gilab_refcache_" + std::to_string(::getpid()) + "_" +
-                                              info->test_suite_name() + "_" + info->name());
-        fs::remove_all(m_path);
-        fs::create_directories(m_path);
-    }
-    ~TempDir() {
-        std::error_code ec;
-        fs::remove_all(m_path, ec);
-    }
-    const fs::path& path() const { return m_path; }
-
-private:
-    fs::path m_path;
+    TempDir() : test::TempDir("gilab_refcache") {}
 };
 
 /** A synthetic accumulator with irregular values (no rendering). */

@@ -2,6 +2,8 @@
 // camera's raster/ray consistency, the scene description files and every bad-input report.
 #include <gtest/gtest.h>
 
+#include "tests/temp_dir.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <atomic>
@@ -102,25 +104,10 @@ bool isClosed(const Scene& s, int material) {
     return true;
 }
 
-/** A fresh temporary folder per test. */
-class TempDir {
+/** This file's temporary folders (tests/temp_dir.h). */
+class TempDir : public test::TempDir {
 public:
-    TempDir() {
-        static std::atomic<int> counter{0};
-        m_path = fs::temp_directory_path() / ("gilab_scene_test_" + std::to_string(::getpid()) +
-                                              "_" + std::to_string(counter++));
-        fs::create_directories(m_path);
-    }
-    ~TempDir() { fs::remove_all(m_path); }
-    std::string write(const std::string& name, const std::string& text) const {
-        const std::string path = (m_path / name).string();
-        std::ofstream(path, std::ios::binary) << text;
-        return path;
-    }
-    std::string path(const std::string& name) const { return (m_path / name).string(); }
-
-private:
-    fs::path m_path;
+    TempDir() : test::TempDir("gilab_scene_test") {}
 };
 
 std::string base64(const std::string& bytes) {

@@ -74,9 +74,7 @@ Evaluator makeEvaluator(const Image& reference, const MetricOptions& options) {
     return e;
 }
 
-nlohmann::ordered_json number(double v) {
-    return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
-}
+using detail::number;
 
 nlohmann::ordered_json barJson(const ResampledBar& b) {
     return {{"spread", number(b.spread)},

@@ -1,8 +1,11 @@
 #pragma once
 /** Helpers shared by the metric sources; not part of the public API (metrics.h). */
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
+
+#include <nlohmann/json.hpp>
 
 #include "core/image/image.h"
 #include "experiments/metrics/metrics.h"
@@ -78,5 +81,10 @@ private:
     bool m_hasSpare = false;
     double m_spare = 0.0;
 };
+
+/** A metric value for the JSON summaries: the number, or null when NaN/Inf. */
+inline nlohmann::ordered_json number(double v) {
+    return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
 
 }  // namespace gilab::metrics::detail

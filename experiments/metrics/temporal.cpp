@@ -52,9 +52,7 @@ double lumVariance(const Image& stdError, size_t p) {
     return v;
 }
 
-nlohmann::ordered_json number(double v) {
-    return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
-}
+using detail::number;
 
 std::string joinNotes(const std::vector<std::string>& notes) {
     std::string out;
