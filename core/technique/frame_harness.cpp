@@ -78,7 +78,8 @@ TechniqueContext FrameHarness::makeContext() {
                          &m_skipped,
                          &m_notes,
                          m_technique->info().id,
-                         &m_setupTimes};
+                         &m_setupTimes,
+                         &m_stats};
     return ctx;
 }
 
@@ -117,8 +118,12 @@ SetupTiming FrameHarness::setup() {
     TechniqueContext ctx = makeContext();
     m_technique->setup(ctx);
     t.techniqueSetupMs = sw.elapsedMs();
-    for (const PassTimeRecord& p : m_setupTimes)
-        t.passes.push_back({p.name, p.gpuMs, 0.0});
+    for (const PassTimeRecord& p : m_setupTimes) {
+        if (p.cpuMs >= 0.0)
+            t.cpuPasses.emplace_back(p.name, p.cpuMs);
+        else
+            t.passes.push_back({p.name, p.gpuMs, 0.0});
+    }
     t.totalMs = total.elapsedMs();
     m_ready = true;
     return t;
@@ -168,7 +173,7 @@ FrameTiming FrameHarness::renderFrame() {
         uctx.timer = timer;  // submitTimed resets and resolves it per submission
         t.update = m_technique->update(uctx, m_pending);
         for (const PassTimeRecord& p : m_setupTimes)
-            t.updatePasses.push_back({p.name, p.gpuMs, 0.0});
+            if (p.cpuMs < 0.0) t.updatePasses.push_back({p.name, p.gpuMs, 0.0});
         m_setupTimes.clear();
         t.updateCpuMs = update.elapsedMs();
         m_pending = SceneChanges{};

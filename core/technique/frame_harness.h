@@ -35,6 +35,7 @@ struct SetupTiming {
     double techniqueSetupMs = 0.0;  // CPU wall time of technique.setup()
     double totalMs = 0.0;
     std::vector<vk::PassTime> passes;  // GPU times of set-up passes recorded with the timer
+    std::vector<std::pair<std::string, double>> cpuPasses;  // CPU set-up passes (timeCpu), ms
 };
 
 struct FrameTiming {
@@ -89,6 +90,8 @@ public:
 
     const std::vector<std::string>& skipped() const { return m_skipped; }
     const std::vector<std::string>& notes() const { return m_notes; }
+    /** Named numbers the technique reported (TechniqueContext::stat). */
+    const std::vector<std::pair<std::string, double>>& stats() const { return m_stats; }
     MemoryReport memory() const;
 
 private:
@@ -107,6 +110,7 @@ private:
     std::unique_ptr<vk::GpuTimer> m_timer;
     std::vector<std::string> m_skipped;
     std::vector<std::string> m_notes;
+    std::vector<std::pair<std::string, double>> m_stats;
     std::vector<PassTimeRecord> m_setupTimes;
     bool m_ready = false;
     bool m_timestamps = true;

@@ -1,5 +1,7 @@
 #include "core/technique/technique.h"
 
+#include <chrono>
+
 #include "core/scene/animation.h"
 
 #include "core/scene/scene.h"
@@ -20,6 +22,17 @@ void TechniqueContext::note(const std::string& text) const {
     if (notes) notes->push_back(techniqueId + ": " + text);
 }
 
+void TechniqueContext::stat(const std::string& name, double value) const {
+    if (!stats) return;
+    for (auto& [n, v] : *stats) {
+        if (n == name) {
+            v = value;
+            return;
+        }
+    }
+    stats->emplace_back(name, value);
+}
+
 void TechniqueContext::submitTimed(const std::function<void(VkCommandBuffer)>& record) const {
     vk.submitAndWait([&](VkCommandBuffer cmd) {
         if (timer) timer->reset(cmd);
@@ -28,6 +41,14 @@ void TechniqueContext::submitTimed(const std::function<void(VkCommandBuffer)>& r
     if (!timer || !setupTimes) return;
     for (const vk::PassTime& p : timer->resolve())
         setupTimes->push_back({p.name, p.gpuMs});
+}
+
+void TechniqueContext::timeCpu(const std::string& name, const std::function<void()>& work) const {
+    const auto start = std::chrono::steady_clock::now();
+    work();
+    const double ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (setupTimes) setupTimes->push_back({techniqueId + "/" + name, 0.0, ms});
 }
 
 PassScope::PassScope(const TechniqueContext& ctx, VkCommandBuffer cmd, const std::string& name)

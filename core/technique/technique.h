@@ -22,6 +22,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -83,6 +84,7 @@ struct DebugView {
 struct PassTimeRecord {
     std::string name;
     double gpuMs = 0.0;
+    double cpuMs = -1.0;  // >= 0: a set-up pass that ran on the CPU (TechniqueContext::timeCpu)
 };
 
 /** What a technique sees while it sets up and renders. */
@@ -102,14 +104,21 @@ struct TechniqueContext {
     std::string tag(const std::string& resource) const;
     void skip(const std::string& pass, const std::string& reason) const;
     void note(const std::string& text) const;
+    /** A named number of the run (counts, sizes: e.g. "clusters"), stored in the result as
+     *  stats.<name> and as a stat.<name> column; a later value of the same name replaces it. */
+    void stat(const std::string& name, double value) const;
     /**
      * For set-up work on the GPU: records with `record` (use PassScope inside to name the
      * passes, e.g. "voxelize"), submits and waits; the pass times are added to the run's set-up
      * timing. Not for use inside render().
      */
     void submitTimed(const std::function<void(VkCommandBuffer)>& record) const;
+    /** For set-up work on the CPU: runs `work` and records its wall time as the CPU pass
+     *  "<technique id>/<name>" of the run's set-up timing (setup_cpu_passes). */
+    void timeCpu(const std::string& name, const std::function<void()>& work) const;
     std::string techniqueId;
     std::vector<PassTimeRecord>* setupTimes = nullptr;  // internal: filled by submitTimed
+    std::vector<std::pair<std::string, double>>* stats = nullptr;  // internal: filled by stat
 };
 
 /**

@@ -73,13 +73,23 @@ Voxelizer::Voxelizer(vk::Context& ctx, const vk::GpuScene& scene, const VoxelGri
     m_accumSet = vk::DescriptorSet(ctx, m_accumLayout, 0, "voxel/accumulate");
     for (uint32_t k = 0; k < kAccumulatorWords; ++k)
         m_accumSet.writeBuffer(0, m_accumulators[k], k);
-    m_voxelizeLayout = vk::PipelineLayout(ctx, {scene.layout().handle(), m_accumLayout.handle()},
-                                          sizeof(GpuVoxelGrid));
+    std::vector<VkDescriptorSetLayout> voxelizeSets = {scene.layout().handle(),
+                                                       m_accumLayout.handle()};
+    if (options.fragmentCapacity > 0) {
+        m_fragments = std::make_unique<VoxelFragmentLists>(ctx, grid, options.fragmentCapacity);
+        voxelizeSets.push_back(m_fragments->layout().handle());
+    }
+    m_voxelizeLayout = vk::PipelineLayout(ctx, voxelizeSets, sizeof(GpuVoxelGrid));
     vk::GraphicsPipelineDesc desc;
     desc.vertexShader = "common/voxelize.vert";
     desc.geometryShader = "common/voxelize.geom";
-    desc.fragmentShader =
-        m_floatAtomics ? "common/voxelize.frag" : "common/voxel_voxelize_fixed.frag";
+    if (m_fragments) {
+        desc.fragmentShader = m_floatAtomics ? "common/voxelize_fragments.frag"
+                                             : "common/voxel_voxelize_fixed_fragments.frag";
+    } else {
+        desc.fragmentShader =
+            m_floatAtomics ? "common/voxelize.frag" : "common/voxel_voxelize_fixed.frag";
+    }
     desc.sceneVertexInput = false;  // pulled from the scene set
     desc.depthTest = false;
     desc.depthWrite = false;
@@ -117,13 +127,15 @@ void Voxelizer::record(VkCommandBuffer cmd, vk::GpuTimer* timer) {
         if (timer) pass.emplace(*timer, cmd, "voxelize");
         for (const vk::Buffer& plane : m_accumulators)
             vkCmdFillBuffer(cmd, plane.handle(), 0, VK_WHOLE_SIZE, 0);
+        if (m_fragments) m_fragments->recordClear(cmd);
         vk::memoryBarrier(cmd);
         if (m_scene.triangleCount() > 0) {
             vk::RenderingScope scope(cmd, {n, n}, {});
             m_voxelize.bind(cmd);
-            VkDescriptorSet sets[2] = {m_scene.set().handle(), m_accumSet.handle()};
+            VkDescriptorSet sets[3] = {m_scene.set().handle(), m_accumSet.handle(),
+                                       m_fragments ? m_fragments->set().handle() : VK_NULL_HANDLE};
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_voxelizeLayout.handle(),
-                                    0, 2, sets, 0, nullptr);
+                                    0, m_fragments ? 3 : 2, sets, 0, nullptr);
             m_voxelizeLayout.push(cmd, push);
             vkCmdDraw(cmd, 3 * m_scene.triangleCount(), 1, 0, 0);
         }
@@ -151,6 +163,10 @@ void Voxelizer::run(vk::GpuTimer* timer) {
         if (timer) timer->reset(cmd);
         record(cmd, timer);
     });
+    if (m_fragments && m_fragments->overflowed()) {
+        m_fragments->grow(m_fragments->written());
+        m_ctx.submitAndWait([&](VkCommandBuffer cmd) { record(cmd, nullptr); });
+    }
 }
 
 VoxelData Voxelizer::readVoxels() {

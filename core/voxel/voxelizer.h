@@ -10,8 +10,11 @@
  * Sums use float atomics when the device has them (Context::hasFloatAtomics), else fixed-point
  * uint atomics (scales and overflow bounds in shaders/common/voxel_grid.glsl).
  * Memory is tagged "voxel/...". After record() the volumes are SHADER_READ_ONLY_OPTIMAL.
+ * Optionally (fragmentCapacity > 0) the voxelize pass also appends every voxel fragment to
+ * per-voxel linked lists (clustered voxel GI §4.1; core/voxel/voxel_fragments.h).
  */
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <vulkan/vulkan.h>
@@ -21,6 +24,7 @@
 #include "core/vk/descriptors.h"
 #include "core/vk/image.h"
 #include "core/vk/pipeline.h"
+#include "core/voxel/voxel_fragments.h"
 #include "core/voxel/voxel_grid.h"
 
 namespace gilab {
@@ -33,6 +37,9 @@ class GpuTimer;
 struct VoxelizerOptions {
     bool fullPrecision = false;    // RGBA32F volumes instead of RGBA16F
     bool forceFixedPoint = false;  // uint accumulators even with float atomics (tests)
+    /** > 0: also build per-voxel fragment lists (VoxelFragmentLists) with room for this many
+     *  fragments; run() grows the buffer and voxelizes again when a scene needs more. */
+    uint32_t fragmentCapacity = 0;
 };
 
 /** The final volumes, resolution^3 each (contents in shaders/common/voxel_resolve_body.glsl). */
@@ -64,8 +71,12 @@ public:
     /** Clears the accumulators, voxelizes the scene and resolves; timed as "voxelize" and
      *  "voxel_resolve" when `timer` is given. */
     void record(VkCommandBuffer cmd, vk::GpuTimer* timer = nullptr);
-    /** record() in its own submission (blocking). */
+    /** record() in its own submission (blocking). With fragment lists, a second run with a
+     *  grown buffer follows when the first overflowed (its time is then counted twice). */
     void run(vk::GpuTimer* timer = nullptr);
+    /** Null unless options.fragmentCapacity > 0. After a run that did not overflow, the lists
+     *  hold every fragment (fragments()->overflowed() says otherwise). */
+    VoxelFragmentLists* fragments() { return m_fragments.get(); }
 
     const VoxelGrid& grid() const { return m_grid; }
     VoxelVolumes& volumes() { return m_volumes; }
@@ -86,6 +97,7 @@ private:
     bool m_floatAtomics = false;
     VkFormat m_format = VK_FORMAT_R16G16B16A16_SFLOAT;
     std::vector<vk::Buffer> m_accumulators;  // one plane of N^3 words each
+    std::unique_ptr<VoxelFragmentLists> m_fragments;
     VoxelVolumes m_volumes;
     vk::DescriptorSetLayout m_accumLayout, m_resolveSetLayout;
     vk::DescriptorSet m_accumSet, m_resolveSet;

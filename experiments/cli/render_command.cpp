@@ -141,6 +141,9 @@ int runRender(const RenderOptions& options) {
     meta["memory"] = memoryJson(harness->memory());
     meta["skipped_passes"] = harness->skipped();
     meta["notes"] = harness->notes();
+    meta["stats"] = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : harness->stats())
+        meta["stats"][name] = value;
     harness.reset();
 
     writeExrWithMainImage(exrPath.string(), layers, "final");

@@ -205,6 +205,9 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
     nlohmann::ordered_json setupPasses = nlohmann::ordered_json::array();
     for (const vk::PassTime& p : setup.passes)
         setupPasses.push_back({{"name", p.name}, {"gpu_ms", number(p.gpuMs)}});
+    nlohmann::ordered_json setupCpuPasses = nlohmann::ordered_json::array();
+    for (const auto& [name, ms] : setup.cpuPasses)
+        setupCpuPasses.push_back({{"name", name}, {"cpu_ms", number(ms)}});
     nlohmann::ordered_json passes = nlohmann::ordered_json::array();
     std::vector<double> gpuTotal(frames.size(), 0.0);
     for (const std::string& name : order) {
@@ -226,6 +229,7 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
               {"technique", setup.techniqueSetupMs},
               {"total", setup.totalMs}}},
             {"setup_gpu_passes", setupPasses},
+            {"setup_cpu_passes", setupCpuPasses},
             {"warmup_frames", warmupFrames},
             {"timed_frames", frames.size()},
             {"frame_cpu_ms", summaryJson(cpu)},

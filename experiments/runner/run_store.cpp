@@ -174,6 +174,10 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
             row[prefix + ".debiased"] = at({"metrics", "sequence", basis, "debiased"});
         }
     }
+    const Json stats = at({"stats"});  // technique numbers (TechniqueContext::stat)
+    if (stats.is_object())
+        for (const auto& [name, value] : stats.items())
+            row["stat." + name] = value;
     addNonFiniteColumns(row, at({"nonfinite"}));
     row["output_exr"] = at({"outputs", "exr"}).is_string()
                             ? Json("runs/" + at({"key"}).get<std::string>() + "/" +

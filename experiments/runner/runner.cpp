@@ -359,6 +359,9 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["memory"] = cli::memoryJson(harness->memory());
     result["skipped_passes"] = harness->skipped();
     result["notes"] = harness->notes();
+    result["stats"] = nlohmann::ordered_json::object();
+    for (const auto& [name, value] : harness->stats())
+        result["stats"][name] = value;
     harness.reset();
     result["metrics"] = computeRunMetrics(layers, matched, claimedBounces(info, run.params),
                                           c.config.metrics, tm, tmp);

@@ -22,6 +22,30 @@ layout(set = 1, binding = 0, std430) buffer VoxelAccumulators {
 } voxelAcc[VOXEL_ACC_WORDS];
 #endif
 
+#ifdef VOXEL_FRAGMENT_LISTS
+// Per-voxel fragment lists (Cosin Ayerbe & Patow 2022 §4.1, Fig. 3; core/voxel/voxel_fragments.h):
+// a linear fragment buffer appended with an atomic counter and one list head per voxel, linked by
+// atomicExchange. Fragments past the capacity are counted, not written (the host re-runs).
+#include "common/voxel_fragments.glsl"
+layout(set = 2, binding = 0, std430) buffer VoxelHeads {
+    uint heads[];
+};
+layout(set = 2, binding = 1, std430) buffer VoxelFragmentBuffer {
+    VoxelFragment fragments[];
+};
+layout(set = 2, binding = 2, std430) buffer VoxelFragmentCounter {
+    uint fragmentCount;
+    uint fragmentCapacity;
+};
+
+void appendFragment(uint voxel, vec3 position, vec3 normal, vec3 albedo) {
+    uint slot = atomicAdd(fragmentCount, 1u);
+    if (slot >= fragmentCapacity) return;
+    uint next = atomicExchange(heads[voxel], slot);
+    fragments[slot] = voxelPackFragment(position, normal, albedo, next);
+}
+#endif
+
 layout(location = 0) flat in uint inTriangle;
 layout(location = 1) flat in uint inAxis;
 layout(location = 2) flat in vec3 inP0;
@@ -97,5 +121,9 @@ void main() {
         if (!voxelTriangleBoxOverlap(cell + 0.5, halfSize, inP0, inP1, inP2)) continue;
         ivec3 c = ivec3(swizzleFromAxis(cell, inAxis));
         accumulate(voxelLinearIndex(pc.grid, c), baseColor.rgb, normal, emission);
+#ifdef VOXEL_FRAGMENT_LISTS
+        vec3 position = bary.x * v0.position + bary.y * v1.position + bary.z * v2.position;
+        appendFragment(voxelLinearIndex(pc.grid, c), position, normal, baseColor.rgb);
+#endif
     }
 }

@@ -1,0 +1,53 @@
+#version 460
+#extension GL_GOOGLE_include_directive : require
+// Emitter update, step 4 (§4.4): one pass of the 3D Gaussian over the same-direction faces of the
+// neighbours of each camera-visible voxel. Empty neighbours, neighbours not gathered for this
+// emitter state and faces that gathered nothing ("non-lit") get weight 0, then the weights are
+// renormalised (no shadow leaks). Run twice: faceIrradiance -> faceTemp -> faceFiltered.
+#include "cvgi/cvgi_common.glsl"
+
+layout(local_size_x = 64) in;
+
+// Buffers: 0 faceIrradiance, 1 faceTemp, 2 faceFiltered (the host ping-pongs them).
+layout(push_constant, std430) uniform Push {
+    uint src;
+    uint dst;
+    uint copy;    // 1: dst = src (no filtering)
+    uint stride;  // threads per dispatch row
+} pc;
+
+vec4 source(uint face) {
+    return pc.src == 0u ? faceIrradiance[face] : (pc.src == 1u ? faceTemp[face] : faceFiltered[face]);
+}
+void store(uint face, vec4 e) {
+    if (pc.dst == 1u) faceTemp[face] = e;
+    else faceFiltered[face] = e;
+}
+
+void main() {
+    uint t = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * pc.stride;
+    if (t >= u.counts.x * 6u) return;
+    uint i = t / 6u, f = t % 6u;
+    if ((voxelState[i] & CVGI_VISIBLE) == 0u) return;
+    if (pc.copy != 0u) {
+        store(t, source(t));
+        return;
+    }
+    int radius = int(u.options.x);
+    float inv2s2 = 0.5 / (u.biases.w * u.biases.w);
+    ivec3 c = cvgiCoord(i);
+    vec3 sum = vec3(0.0);
+    float weight = 0.0;
+    for (int z = -radius; z <= radius; ++z)
+        for (int y = -radius; y <= radius; ++y)
+            for (int x = -radius; x <= radius; ++x) {
+                uint j = cvgiIndexAt(c + ivec3(x, y, z));
+                if (j == CVGI_EMPTY || (voxelState[j] & CVGI_PROCESSED) == 0u) continue;
+                vec4 e = source(6u * j + f);
+                if (e.w <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;  // non-lit face
+                float w = exp(-float(x * x + y * y + z * z) * inv2s2);
+                sum += w * e.rgb;
+                weight += w;
+            }
+    store(t, vec4(weight > 0.0 ? sum / weight : vec3(0.0), 1.0));
+}

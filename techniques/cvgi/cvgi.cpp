@@ -1,0 +1,209 @@
+#include "techniques/cvgi/cvgi.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+#include "core/passes/shared_passes.h"
+#include "core/scene/animation.h"
+#include "core/scene/scene.h"
+#include "core/technique/registry.h"
+#include "core/util/error.h"
+#include "core/vk/context.h"
+#include "core/voxel/voxel_compaction.h"
+#include "core/voxel/voxelizer.h"
+#include "techniques/cvgi/cvgi_gpu.h"
+#include "techniques/cvgi/cvgi_readback.h"
+#include "techniques/cvgi/cvgi_setup.h"
+
+namespace gilab {
+namespace {
+
+constexpr float kCubeSpotOuterRad = 1.4835299f;  // spots wider than 85 deg have no 2D map
+
+std::string mib(double bytes) {
+    char s[32];
+    std::snprintf(s, sizeof(s), "%.1f MiB", bytes / (1024.0 * 1024.0));
+    return s;
+}
+
+}  // namespace
+
+CvgiTechnique::CvgiTechnique() = default;
+CvgiTechnique::~CvgiTechnique() = default;
+
+TechniqueInfo CvgiTechnique::describe() {
+    TechniqueInfo info;
+    info.id = "cvgi";
+    info.description =
+        "Clustered voxel GI: voxel clusters, per-face cached cluster visibility, per-face "
+        "irradiance gathered on emitter changes (one diffuse bounce)";
+    info.citation =
+        "A. Cosin Ayerbe, G. Patow, \"Clustered voxel real-time global illumination\", "
+        "Computers & Graphics 103 (2022), doi 10.1016/j.cag.2022.01.005";
+    info.params = cvgiParamSpecs();
+    info.indirectBounces = 1;
+    info.supports.pointLights = false;       // would need six distance maps (§5.2)
+    info.supports.emissiveSurfaces = false;  // only emitters with a shadow-map camera
+    return info;
+}
+
+SupportResult CvgiTechnique::checkSupport(const Scene& scene, const ParamSet& params) const {
+    SupportResult base = Technique::checkSupport(scene, params);
+    if (!base.supported) {
+        base.reason += " (the paper's emitters need one distance map from a camera: spot or "
+                       "directional lights)";
+        return base;
+    }
+    bool emitter = false;
+    for (const Light& l : scene.lights) {
+        if (l.type == LightType::Spot && l.outerConeRad > kCubeSpotOuterRad)
+            return {false, "spot light '" + l.name +
+                               "' is wider than 85 deg: it has no single distance map"};
+        emitter = emitter || l.type == LightType::Spot || l.type == LightType::Directional;
+    }
+    if (!emitter) return {false, "needs a spot or directional light (the paper's emitters)"};
+    return {};
+}
+
+void CvgiTechnique::setup(TechniqueContext& ctx) {
+    m_gpu.reset();
+    const CvgiSettings s = cvgiSettingsFrom(ctx.params);
+    const VoxelGrid grid(ctx.scene.caps.bounds, s.voxelResolution);
+    const uint32_t n = s.voxelResolution;
+
+    // §4.1: voxelization with fragment lists, then the prefix-sum compaction.
+    VoxelizerOptions vo;
+    const uint64_t maxFragments =
+        ctx.vk.properties().limits.maxStorageBufferRange / sizeof(GpuVoxelFragment);
+    vo.fragmentCapacity = uint32_t(std::min<uint64_t>(maxFragments, std::max(1u << 20, 24 * n * n)));
+    auto voxelizer = std::make_unique<Voxelizer>(ctx.vk, ctx.gpuScene, grid, vo);
+    VoxelFragmentLists& lists = *voxelizer->fragments();
+    auto voxelize = [&] {
+        ctx.submitTimed([&](VkCommandBuffer cmd) {
+            PassScope pass(ctx, cmd, "voxelization");
+            voxelizer->record(cmd, nullptr);
+        });
+    };
+    voxelize();
+    const uint32_t fragmentCount = lists.written();
+    if (fragmentCount > lists.capacity()) {
+        ctx.note("fragment buffer grown from " + std::to_string(lists.capacity()) + " to " +
+                 std::to_string(fragmentCount) + " fragments: voxelization ran twice");
+        lists.grow(fragmentCount);
+        voxelize();
+    }
+    voxelizer->releaseAccumulators();
+    VoxelCompaction compaction(ctx.vk, grid, lists.heads());
+    ctx.submitTimed([&](VkCommandBuffer cmd) {
+        PassScope pass(ctx, cmd, "prefix_sum");
+        compaction.recordScan(cmd);
+    });
+    const uint32_t occupied = compaction.readOccupied();
+    ctx.submitTimed([&](VkCommandBuffer cmd) {
+        PassScope pass(ctx, cmd, "prefix_sum");
+        compaction.recordFill(cmd, occupied);
+    });
+    cvgi::CompactVoxels voxels;
+    ctx.timeCpu("voxel_readback", [&] {
+        voxels = readCompactVoxels(grid, compaction, lists, fragmentCount);
+    });
+    voxelizer.reset();  // fragments, heads and volumes are no longer needed
+
+    // §4.2-4.3 on the CPU (docs/techniques/cvgi.md "Where it runs").
+    std::vector<uint8_t> axis;
+    cvgi::Clusters clusters;
+    cvgi::FaceVisibility visibility;
+    ctx.timeCpu("heuristic_normal", [&] { axis = cvgi::heuristicNormals(voxels); });
+    ctx.timeCpu("clustering", [&] {
+        cvgi::ClusteringParams cp;
+        cp.initialClusters =
+            s.initialClusters > 0 ? s.initialClusters : cvgi::paperInitialClusters(n);
+        cp.iterations = s.clusterIterations;
+        cp.angleDeg = s.clusterAngleDeg;
+        clusters = cvgi::clusterVoxels(voxels, axis, cp);
+    });
+    ctx.timeCpu("cluster_visibility", [&] {
+        cvgi::VisibilityParams vp;
+        vp.raysPerFace = s.raysPerFace;
+        visibility = cvgi::faceVisibility(voxels, clusters, vp);
+    });
+
+    m_gpu = std::make_unique<CvgiGpu>(ctx.vk, ctx.gpuScene, ctx.shared, grid,
+                                      std::move(compaction.voxelIndex()),
+                                      std::move(compaction.hashedPosition()), voxels, axis,
+                                      clusters, visibility, s, ctx.tag("gi"));
+    const uint32_t v = voxels.count();
+    ctx.stat("voxels", v);
+    ctx.stat("fragments", fragmentCount);
+    ctx.stat("initial_clusters", clusters.seeds);
+    ctx.stat("clusters", clusters.count());
+    ctx.stat("cluster_percent", v > 0 ? 100.0 * clusters.count() / v : 0.0);
+    ctx.stat("unassigned_voxels", clusters.unassigned);
+    ctx.stat("visibility_entries", double(visibility.clusters.size()));
+    ctx.stat("visibility_max_per_face", visibility.maxPerFace);
+    ctx.stat("visibility_compacted_percent",
+             visibility.uncompactedEntries > 0
+                 ? 100.0 * double(visibility.clusters.size()) / double(visibility.uncompactedEntries)
+                 : 0.0);
+    ctx.stat("memory_final_mib", double(m_gpu->finalBytes()) / (1024.0 * 1024.0));
+    ctx.note("voxel grid " + std::to_string(n) + "^3: " + std::to_string(v) + " voxels, " +
+             std::to_string(clusters.count()) + " clusters from " +
+             std::to_string(clusters.seeds) + " seeds, " + std::to_string(clusters.unassigned) +
+             " voxels unassigned (never a source, still occluders); visibility " +
+             std::to_string(visibility.clusters.size()) + " entries (" + mib(4.0 * visibility.clusters.size()) +
+             "); bounce + frame buffers " + mib(double(m_gpu->finalBytes())));
+    ctx.note(std::to_string(m_gpu->emitterCount()) +
+             " emitter(s) with a distance map; static geometry assumed (a geometry change "
+             "re-runs the set-up)");
+    if (ctx.scene.lights.size() > m_gpu->emitterCount())
+        ctx.skip("bounce from other lights", "only spot and directional lights are emitters");
+    emitterUpdate(ctx);
+}
+
+void CvgiTechnique::emitterUpdate(TechniqueContext& ctx) {
+    const float aspect = float(ctx.width) / float(std::max(ctx.height, 1u));
+    m_gpu->setCamera(ctx.scene.camera, aspect);
+    ctx.submitTimed([&](VkCommandBuffer cmd) { m_gpu->recordEmitterUpdate(ctx, cmd); });
+    recordUpdateStats(ctx);
+}
+
+void CvgiTechnique::recordUpdateStats(TechniqueContext& ctx) {
+    const CvgiCounters c = m_gpu->readCounters();
+    ctx.stat("lit_voxels", c.litVoxels);
+    ctx.stat("visible_voxels", c.visible);
+    ctx.stat("gathered_voxels", c.gathered);
+}
+
+void CvgiTechnique::onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys) {
+    if (!m_gpu || ctx.params.changesNeedRebuild(keys)) {
+        setup(ctx);
+        return;
+    }
+    m_gpu->setSettings(cvgiSettingsFrom(ctx.params));
+    emitterUpdate(ctx);  // the cached faces depend on every update parameter
+}
+
+UpdateKind CvgiTechnique::update(TechniqueContext& ctx, const SceneChanges& changes) {
+    if (changes.geometry || !m_gpu) return Technique::update(ctx, changes);
+    if (!changes.lights.empty()) {
+        emitterUpdate(ctx);  // §4.4: an emitter change invalidates every cached face
+        return UpdateKind::Incremental;
+    }
+    if (!changes.camera) return UpdateKind::None;
+    const float aspect = float(ctx.width) / float(std::max(ctx.height, 1u));
+    m_gpu->setCamera(ctx.scene.camera, aspect);
+    ctx.submitTimed([&](VkCommandBuffer cmd) { m_gpu->recordCameraUpdate(ctx, cmd); });
+    recordUpdateStats(ctx);
+    return UpdateKind::Incremental;
+}
+
+void CvgiTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) {
+    if (!m_gpu) throw Error("cvgi: render() before setup()");
+    PassScope pass(ctx, cmd, "final_frame");
+    m_gpu->recordFinalFrame(cmd, targets.indirect);
+}
+
+GILAB_REGISTER_TECHNIQUE(CvgiTechnique)
+
+}  // namespace gilab
