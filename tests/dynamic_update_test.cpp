@@ -321,6 +321,16 @@ TEST_F(GpuDynamic, DvsTwoBouncesRegathers) {
                         {"dvs/voxel_direct", "dvs/filter", "dvs/voxel_bounce", "dvs/filter2"}});
 }
 
+// cvgi (issue 12): an emitter move re-runs the paper's Table 2 passes and clears the face cache.
+TEST_F(GpuDynamic, CvgiRegathersOnEmitterMove) {
+    checkMoveAndReturn(*m_ctx, {"cvgi",
+                                {{"voxel_resolution", "32"}, {"shadow_map_size", "512"}},
+                                UpdateKind::Incremental,
+                                {"cvgi/dist_shadow_map", "cvgi/lit_cluster",
+                                 "cvgi/camera_visible_voxel", "cvgi/light_bounce",
+                                 "cvgi/gaussian_filtering"}});
+}
+
 // Timing only (run with --gtest_also_run_disabled_tests): the same checks at N = 64.
 TEST_F(GpuDynamic, DISABLED_UpdateTimesAt64) {
     checkMoveAndReturn(*m_ctx, {"vct", {{"voxel_resolution", "64"}}, UpdateKind::Incremental, {}});
