@@ -170,7 +170,7 @@ TEST_F(GpuCvgi, SpotCornellIndirectIsFiniteAndNearTheOneBounceReference) {
     ASSERT_TRUE(tracer.addSamples(acc, 256));
     double reference = 0.0;
     const Image bounce = ref::meanImage(acc, ref::Layer::Bounce1);  // named: values() of a
-    for (float v : bounce.values())                                  // temporary would dangle
+    for (float v : bounce.values())                                 // temporary would dangle
         reference += v;
     ASSERT_GT(reference, 0.0);
     std::printf("spot Cornell 32^2, N = 32, 1024 rays: indirect energy cvgi / reference = %.3f\n",
@@ -180,8 +180,8 @@ TEST_F(GpuCvgi, SpotCornellIndirectIsFiniteAndNearTheOneBounceReference) {
 }
 
 TEST_F(GpuCvgi, UnsupportedLightsGiveAReason) {
-    Scene point = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json",
-                                "point");
+    Scene point =
+        loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", "point");
     FrameHarness a(*m_ctx, point, "cvgi", cvgiParams({}), defaultSharedParams());
     EXPECT_FALSE(a.support().supported);
     EXPECT_NE(a.support().reason.find("point"), std::string::npos) << a.support().reason;

@@ -14,8 +14,9 @@ namespace gilab {
 
 DistanceView DistanceView::fromPassLight(const PassLight& light) {
     if (uint32_t(light.shadow.x) != kShadowMap2D) {
-        throw Error("DistanceView: the light has no 2D shadow view (a point light or a spot "
-                    "wider than the 2D maps take)");
+        throw Error(
+            "DistanceView: the light has no 2D shadow view (a point light or a spot "
+            "wider than the 2D maps take)");
     }
     DistanceView v;
     v.viewProj = light.viewProj;

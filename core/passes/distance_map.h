@@ -10,8 +10,8 @@
 #include <cstdint>
 #include <string>
 
-#include <glm/glm.hpp>
 #include <vulkan/vulkan.h>
+#include <glm/glm.hpp>
 
 #include "core/vk/image.h"
 #include "core/vk/pipeline.h"

@@ -23,8 +23,8 @@ VoxelCompaction::VoxelCompaction(vk::Context& ctx, const VoxelGrid& grid, const 
     m_blockCount = uint32_t((voxels + kBlock - 1) / kBlock);
     m_blocks = vk::Buffer(ctx, VkDeviceSize(m_blockCount + 1) * 4, kStorage,
                           vk::MemoryUsage::DeviceLocal, "voxel/compact_blocks");
-    m_voxelIndex = vk::Buffer(ctx, VkDeviceSize(voxels) * 4, kStorage,
-                              vk::MemoryUsage::DeviceLocal, "voxel/voxel_index");
+    m_voxelIndex = vk::Buffer(ctx, VkDeviceSize(voxels) * 4, kStorage, vk::MemoryUsage::DeviceLocal,
+                              "voxel/voxel_index");
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     m_scanLayout = vk::DescriptorSetLayout(ctx,
                                            {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs},
@@ -50,8 +50,8 @@ VoxelCompaction::VoxelCompaction(vk::Context& ctx, const VoxelGrid& grid, const 
 void VoxelCompaction::recordScan(VkCommandBuffer cmd) {
     const Push push{uint32_t(m_grid.voxelCount()), m_blockCount};
     VkDescriptorSet set = m_scanSet.handle();
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_scanPipelineLayout.handle(), 0, 1,
-                            &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_scanPipelineLayout.handle(), 0,
+                            1, &set, 0, nullptr);
     m_scanPipelineLayout.push(cmd, push);
     m_count.bind(cmd);
     vkCmdDispatch(cmd, m_blockCount, 1, 1);
@@ -69,10 +69,10 @@ uint32_t VoxelCompaction::readOccupied() {
 void VoxelCompaction::recordFill(VkCommandBuffer cmd, uint32_t occupied) {
     m_occupied = occupied;
     const VkDeviceSize bytes = VkDeviceSize(std::max(occupied, 1u)) * 4;
-    m_fragmentIndex = vk::Buffer(m_ctx, bytes, kStorage, vk::MemoryUsage::DeviceLocal,
-                                 "voxel/fragment_index");
-    m_hashedPosition = vk::Buffer(m_ctx, bytes, kStorage, vk::MemoryUsage::DeviceLocal,
-                                  "voxel/hashed_position");
+    m_fragmentIndex =
+        vk::Buffer(m_ctx, bytes, kStorage, vk::MemoryUsage::DeviceLocal, "voxel/fragment_index");
+    m_hashedPosition =
+        vk::Buffer(m_ctx, bytes, kStorage, vk::MemoryUsage::DeviceLocal, "voxel/hashed_position");
     m_fillSet = vk::DescriptorSet(m_ctx, m_fillLayout, 0, "voxel/compact_fill");
     m_fillSet.writeBuffer(0, m_heads);
     m_fillSet.writeBuffer(1, m_blocks);
@@ -81,8 +81,8 @@ void VoxelCompaction::recordFill(VkCommandBuffer cmd, uint32_t occupied) {
     m_fillSet.writeBuffer(4, m_voxelIndex);
     const Push push{uint32_t(m_grid.voxelCount()), m_blockCount};
     VkDescriptorSet set = m_fillSet.handle();
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_fillPipelineLayout.handle(), 0, 1,
-                            &set, 0, nullptr);
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_fillPipelineLayout.handle(), 0,
+                            1, &set, 0, nullptr);
     m_fillPipelineLayout.push(cmd, push);
     m_fill.bind(cmd);
     vkCmdDispatch(cmd, m_blockCount, 1, 1);

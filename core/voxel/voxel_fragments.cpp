@@ -48,9 +48,10 @@ VoxelFragmentLists::VoxelFragmentLists(vk::Context& ctx, const VoxelGrid& grid, 
     const VkDeviceSize headBytes = VkDeviceSize(grid.voxelCount()) * 4;
     checkRange(ctx, headBytes,
                "the voxel buffer of " + std::to_string(grid.resolution()) + "^3 list heads");
-    m_heads = vk::Buffer(ctx, headBytes, kStorage, vk::MemoryUsage::DeviceLocal,
-                         "voxel/fragment_heads");
-    m_counter = vk::Buffer(ctx, 8, kStorage, vk::MemoryUsage::DeviceLocal, "voxel/fragment_counter");
+    m_heads =
+        vk::Buffer(ctx, headBytes, kStorage, vk::MemoryUsage::DeviceLocal, "voxel/fragment_heads");
+    m_counter =
+        vk::Buffer(ctx, 8, kStorage, vk::MemoryUsage::DeviceLocal, "voxel/fragment_counter");
     const VkShaderStageFlags fs = VK_SHADER_STAGE_FRAGMENT_BIT;
     m_layout = vk::DescriptorSetLayout(ctx,
                                        {{0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, fs},

@@ -108,7 +108,7 @@ float cvgiDiskFormFactor(vec3 x, vec3 n, vec3 y, vec3 m, float area) {
     float r2 = dot(d, d);
     if (r2 < 1e-12) return 0.0;
     vec3 w = d * inversesqrt(r2);
-    float cosR = max(dot(n, w), 0.0), cosS = max(-dot(m, w), 0.0);
+    float cosR = clamp(dot(n, w), 0.0, 1.0), cosS = clamp(-dot(m, w), 0.0, 1.0);
     return cosR * cosS * area / (3.14159265358979 * r2 + area);
 }
 

@@ -51,8 +51,9 @@ TechniqueInfo CvgiTechnique::describe() {
 SupportResult CvgiTechnique::checkSupport(const Scene& scene, const ParamSet& params) const {
     SupportResult base = Technique::checkSupport(scene, params);
     if (!base.supported) {
-        base.reason += " (the paper's emitters need one distance map from a camera: spot or "
-                       "directional lights)";
+        base.reason +=
+            " (the paper's emitters need one distance map from a camera: spot or "
+            "directional lights)";
         return base;
     }
     bool emitter = false;
@@ -76,7 +77,8 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
     VoxelizerOptions vo;
     const uint64_t maxFragments =
         ctx.vk.properties().limits.maxStorageBufferRange / sizeof(GpuVoxelFragment);
-    vo.fragmentCapacity = uint32_t(std::min<uint64_t>(maxFragments, std::max(1u << 20, 24 * n * n)));
+    vo.fragmentCapacity =
+        uint32_t(std::min<uint64_t>(maxFragments, std::max(1u << 20, 24 * n * n)));
     auto voxelizer = std::make_unique<Voxelizer>(ctx.vk, ctx.gpuScene, grid, vo);
     VoxelFragmentLists& lists = *voxelizer->fragments();
     auto voxelize = [&] {
@@ -105,9 +107,8 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
         compaction.recordFill(cmd, occupied);
     });
     cvgi::CompactVoxels voxels;
-    ctx.timeCpu("voxel_readback", [&] {
-        voxels = readCompactVoxels(grid, compaction, lists, fragmentCount);
-    });
+    ctx.timeCpu("voxel_readback",
+                [&] { voxels = readCompactVoxels(grid, compaction, lists, fragmentCount); });
     voxelizer.reset();  // fragments, heads and volumes are no longer needed
 
     // §4.2-4.3 on the CPU (docs/techniques/cvgi.md "Where it runs").
@@ -136,23 +137,24 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
     const uint32_t v = voxels.count();
     ctx.stat("voxels", v);
     ctx.stat("fragments", fragmentCount);
-    ctx.stat("initial_clusters", clusters.seeds);
+    ctx.stat("seeds", clusters.seeds);
     ctx.stat("clusters", clusters.count());
     ctx.stat("cluster_percent", v > 0 ? 100.0 * clusters.count() / v : 0.0);
     ctx.stat("unassigned_voxels", clusters.unassigned);
     ctx.stat("visibility_entries", double(visibility.clusters.size()));
     ctx.stat("visibility_max_per_face", visibility.maxPerFace);
-    ctx.stat("visibility_compacted_percent",
-             visibility.uncompactedEntries > 0
-                 ? 100.0 * double(visibility.clusters.size()) / double(visibility.uncompactedEntries)
-                 : 0.0);
+    ctx.stat("visibility_compacted_percent", visibility.uncompactedEntries > 0
+                                                 ? 100.0 * double(visibility.clusters.size()) /
+                                                       double(visibility.uncompactedEntries)
+                                                 : 0.0);
     ctx.stat("memory_final_mib", double(m_gpu->finalBytes()) / (1024.0 * 1024.0));
     ctx.note("voxel grid " + std::to_string(n) + "^3: " + std::to_string(v) + " voxels, " +
-             std::to_string(clusters.count()) + " clusters from " +
-             std::to_string(clusters.seeds) + " seeds, " + std::to_string(clusters.unassigned) +
+             std::to_string(clusters.count()) + " clusters from " + std::to_string(clusters.seeds) +
+             " seeds, " + std::to_string(clusters.unassigned) +
              " voxels unassigned (never a source, still occluders); visibility " +
-             std::to_string(visibility.clusters.size()) + " entries (" + mib(4.0 * visibility.clusters.size()) +
-             "); bounce + frame buffers " + mib(double(m_gpu->finalBytes())));
+             std::to_string(visibility.clusters.size()) + " entries (" +
+             mib(4.0 * visibility.clusters.size()) + "); bounce + frame buffers " +
+             mib(double(m_gpu->finalBytes())));
     ctx.note(std::to_string(m_gpu->emitterCount()) +
              " emitter(s) with a distance map; static geometry assumed (a geometry change "
              "re-runs the set-up)");

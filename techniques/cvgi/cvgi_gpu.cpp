@@ -123,8 +123,8 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
     // Per-update state.
     const VkDeviceSize v = m_voxelCount;
     m_voxelLight = storage(ctx, v * 16, tag + "/voxel_light");
-    m_clusterLight = storage(ctx, VkDeviceSize(m_clusterCount) * kClusterLightBytes,
-                             tag + "/cluster_light");
+    m_clusterLight =
+        storage(ctx, VkDeviceSize(m_clusterCount) * kClusterLightBytes, tag + "/cluster_light");
     m_voxelState = storage(ctx, v * 4, tag + "/voxel_state");
     m_faceIrradiance = storage(ctx, v * 6 * 16, tag + "/face_irradiance");
     m_faceTemp = storage(ctx, v * 6 * 16, tag + "/face_temp");
@@ -161,12 +161,11 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
     m_setLayout = vk::DescriptorSetLayout(ctx, bindings, tag + "/passes");
     m_set = vk::DescriptorSet(ctx, m_setLayout, 0, tag + "/passes");
     m_set.writeUniformBuffer(0, m_uniforms);
-    const vk::Buffer* buffers[] = {&m_voxelIndex,     &m_hashedPosition, &m_voxels,
-                                   &m_clusters,       &m_clusterVoxels,  &m_faceOffset,
-                                   &m_faceClusters,   &m_voxelLight,     &m_clusterLight,
-                                   &m_voxelState,     &m_faceIrradiance, &m_faceTemp,
-                                   &m_faceFiltered,   &m_counters,       &m_gatherList,
-                                   &shadows.lightBuffer()};
+    const vk::Buffer* buffers[] = {
+        &m_voxelIndex,    &m_hashedPosition, &m_voxels,         &m_clusters,
+        &m_clusterVoxels, &m_faceOffset,     &m_faceClusters,   &m_voxelLight,
+        &m_clusterLight,  &m_voxelState,     &m_faceIrradiance, &m_faceTemp,
+        &m_faceFiltered,  &m_counters,       &m_gatherList,     &shadows.lightBuffer()};
     for (uint32_t b = 0; b < 16; ++b)
         m_set.writeBuffer(b + 1, *buffers[b]);
     m_set.writeSampledImage(17, m_emitterMap->image().view(), m_sampler.handle());
@@ -337,9 +336,9 @@ CvgiCounters CvgiGpu::readCounters() {
 uint64_t CvgiGpu::finalBytes() const {
     uint64_t sum = 0;
     for (const vk::Buffer* b :
-         {&m_voxelIndex, &m_hashedPosition, &m_voxels, &m_clusters, &m_clusterVoxels,
-          &m_faceOffset, &m_faceClusters, &m_voxelLight, &m_clusterLight, &m_voxelState,
-          &m_faceIrradiance, &m_faceTemp, &m_faceFiltered, &m_counters, &m_gatherList})
+         {&m_voxelIndex, &m_hashedPosition, &m_voxels, &m_clusters, &m_clusterVoxels, &m_faceOffset,
+          &m_faceClusters, &m_voxelLight, &m_clusterLight, &m_voxelState, &m_faceIrradiance,
+          &m_faceTemp, &m_faceFiltered, &m_counters, &m_gatherList})
         sum += b->size();
     return sum;
 }

@@ -22,13 +22,13 @@ inline glm::ivec3 axisDirection(uint32_t face) {
 }
 
 struct CompactVoxels {
-    uint32_t resolution = 0;              // N voxels per axis
-    std::vector<uint32_t> linear;         // [V] x + N (y + N z), strictly ascending
-    std::vector<uint32_t> indexOf;        // [N^3] compact index of a voxel, kEmpty if empty
-    std::vector<glm::vec3> albedo;        // [V] mean fragment reflectance (linear)
-    std::vector<glm::vec3> meanNormal;    // [V] normalised mean fragment normal (0 if they cancel)
-    std::vector<uint32_t> fragmentOffset; // [V + 1] CSR into fragmentNormal
-    std::vector<glm::vec3> fragmentNormal;// unit normals of each voxel's fragments
+    uint32_t resolution = 0;               // N voxels per axis
+    std::vector<uint32_t> linear;          // [V] x + N (y + N z), strictly ascending
+    std::vector<uint32_t> indexOf;         // [N^3] compact index of a voxel, kEmpty if empty
+    std::vector<glm::vec3> albedo;         // [V] mean fragment reflectance (linear)
+    std::vector<glm::vec3> meanNormal;     // [V] normalised mean fragment normal (0 if they cancel)
+    std::vector<uint32_t> fragmentOffset;  // [V + 1] CSR into fragmentNormal
+    std::vector<glm::vec3> fragmentNormal;  // unit normals of each voxel's fragments
 
     uint32_t count() const { return uint32_t(linear.size()); }
     glm::ivec3 coord(uint32_t i) const {
@@ -36,8 +36,8 @@ struct CompactVoxels {
         return glm::ivec3(int(h % n), int((h / n) % n), int(h / (n * n)));
     }
     bool inside(const glm::ivec3& c) const {
-        return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < int(resolution) &&
-               c.y < int(resolution) && c.z < int(resolution);
+        return c.x >= 0 && c.y >= 0 && c.z >= 0 && c.x < int(resolution) && c.y < int(resolution) &&
+               c.z < int(resolution);
     }
     /** Compact index at c, kEmpty when c is outside the grid or empty. */
     uint32_t at(const glm::ivec3& c) const {
