@@ -39,6 +39,7 @@ layout(set = 0, binding = 0, std140) uniform CvgiUniforms {
     uvec4 options;   // x Gaussian radius, y neighbour test, z interpolation, w frame height
     mat4 cameraViewProj;
     vec4 cameraEye;  // xyz
+    uvec4 packing;   // x 1: faceClusters holds 16-bit ids, two per word
 } u;
 
 layout(set = 0, binding = 1, std430) readonly buffer VoxelIndex { uint voxelIndex[]; };
@@ -74,6 +75,11 @@ ivec3 cvgiCoord(uint i) {
 uint cvgiIndexAt(ivec3 c) {
     if (!voxelInside(u.grid, c)) return CVGI_EMPTY;
     return voxelIndex[voxelLinearIndex(u.grid, c)];
+}
+
+uint cvgiFaceCluster(uint k) {
+    if (u.packing.x == 0u) return faceClusters[k];
+    return (faceClusters[k >> 1] >> (16u * (k & 1u))) & 0xFFFFu;
 }
 
 uint cvgiAxis(uint i) { return uint(voxels[i].albedoAxis.w + 0.5); }

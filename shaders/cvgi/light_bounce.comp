@@ -47,7 +47,7 @@ void main() {
         vec3 x = vec3(cvgiCoord(v)) + 0.5 + 0.5 * n;  // face centre
         uint first = faceOffset[face], count = faceOffset[face + 1u] - first;
         vec3 e = vec3(0.0);
-        for (uint k = lid; k < count; k += 64u) e += gatherCluster(faceClusters[first + k], x, n);
+        for (uint k = lid; k < count; k += 64u) e += gatherCluster(cvgiFaceCluster(first + k), x, n);
         partial[lid] = e;
         barrier();
         for (uint stride = 32u; stride > 0u; stride >>= 1u) {

@@ -83,6 +83,7 @@ private:
     VoxelGrid m_grid;
     CvgiSettings m_settings;
     uint32_t m_voxelCount = 0, m_clusterCount = 0;
+    bool m_packedFaceClusters = false;
     std::vector<uint32_t> m_emitters;  // pass light indices with a 2D distance view
     glm::mat4 m_cameraViewProj{1.0f};
     glm::vec3 m_cameraEye{0.0f};
