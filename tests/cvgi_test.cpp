@@ -68,7 +68,10 @@ TEST_F(GpuCvgi, CompactionMatchesTheDenseVoxelization) {
     const uint32_t fragments = lists.written();
     ASSERT_FALSE(lists.overflowed());
     EXPECT_GT(lists.capacity(), 64u);
-    const VoxelData dense = voxelizer.readVoxels();
+    EXPECT_THROW(voxelizer.readVoxels(), Error);  // fragment-list mode has no volumes
+    Voxelizer denseVoxelizer(*m_ctx, gpuScene, grid);
+    denseVoxelizer.run();
+    const VoxelData dense = denseVoxelizer.readVoxels();
 
     VoxelCompaction compaction(*m_ctx, grid, lists.heads());
     m_ctx->submitAndWait([&](VkCommandBuffer cmd) { compaction.recordScan(cmd); });

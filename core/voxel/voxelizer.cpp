@@ -44,11 +44,37 @@ Voxelizer::Voxelizer(vk::Context& ctx, const vk::GpuScene& scene, const VoxelGri
     m_floatAtomics = ctx.hasFloatAtomics() && !options.forceFixedPoint;
     m_format =
         options.fullPrecision ? VK_FORMAT_R32G32B32A32_SFLOAT : VK_FORMAT_R16G16B16A16_SFLOAT;
+    std::vector<VkDescriptorSetLayout> voxelizeSets = {scene.layout().handle()};
+    vk::GraphicsPipelineDesc desc;
+    if (options.fragmentCapacity > 0) {
+        // Fragment-list mode: the lists at set 1, no accumulators, volumes or resolve.
+        m_fragments = std::make_unique<VoxelFragmentLists>(ctx, grid, options.fragmentCapacity);
+        voxelizeSets.push_back(m_fragments->layout().handle());
+        desc.fragmentShader = "common/voxelize_fragments.frag";
+    } else {
+        createAccumulation(options);
+        voxelizeSets.push_back(m_accumLayout.handle());
+        desc.fragmentShader =
+            m_floatAtomics ? "common/voxelize.frag" : "common/voxel_voxelize_fixed.frag";
+    }
+    m_voxelizeLayout = vk::PipelineLayout(ctx, voxelizeSets, sizeof(GpuVoxelGrid));
+    desc.vertexShader = "common/voxelize.vert";
+    desc.geometryShader = "common/voxelize.geom";
+    desc.sceneVertexInput = false;  // pulled from the scene set
+    desc.depthTest = false;
+    desc.depthWrite = false;
+    desc.cull = VK_CULL_MODE_NONE;
+    desc.name = "voxel/voxelize";
+    m_voxelize = vk::GraphicsPipeline(m_ctx, desc, m_voxelizeLayout);
+}
+
+void Voxelizer::createAccumulation(const VoxelizerOptions& options) {
+    vk::Context& ctx = m_ctx;
     // One buffer per accumulator word keeps each binding under maxStorageBufferRange.
-    const VkDeviceSize planeBytes = VkDeviceSize(grid.voxelCount()) * 4;
+    const VkDeviceSize planeBytes = VkDeviceSize(m_grid.voxelCount()) * 4;
     const VkDeviceSize maxRange = ctx.properties().limits.maxStorageBufferRange;
     if (planeBytes > maxRange) {
-        throw Error("Voxelizer: resolution = " + std::to_string(grid.resolution()) + " needs " +
+        throw Error("Voxelizer: resolution = " + std::to_string(m_grid.resolution()) + " needs " +
                     std::to_string(planeBytes >> 20) + " MiB per accumulator binding, above " +
                     "the device's maxStorageBufferRange (" + std::to_string(maxRange >> 20) +
                     " MiB)");
@@ -60,7 +86,7 @@ Voxelizer::Voxelizer(vk::Context& ctx, const vk::GpuScene& scene, const VoxelGri
                 VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
             vk::MemoryUsage::DeviceLocal, std::string("voxel/accumulators.") + kPlaneNames[k]);
     }
-    const uint32_t n = grid.resolution();
+    const uint32_t n = m_grid.resolution();
     m_volumes.albedoOpacity = makeVolume(ctx, n, m_format, "albedoOpacity");
     m_volumes.normal = makeVolume(ctx, n, m_format, "normal");
     m_volumes.emission = makeVolume(ctx, n, m_format, "emission");
@@ -73,29 +99,6 @@ Voxelizer::Voxelizer(vk::Context& ctx, const vk::GpuScene& scene, const VoxelGri
     m_accumSet = vk::DescriptorSet(ctx, m_accumLayout, 0, "voxel/accumulate");
     for (uint32_t k = 0; k < kAccumulatorWords; ++k)
         m_accumSet.writeBuffer(0, m_accumulators[k], k);
-    std::vector<VkDescriptorSetLayout> voxelizeSets = {scene.layout().handle(),
-                                                       m_accumLayout.handle()};
-    if (options.fragmentCapacity > 0) {
-        m_fragments = std::make_unique<VoxelFragmentLists>(ctx, grid, options.fragmentCapacity);
-        voxelizeSets.push_back(m_fragments->layout().handle());
-    }
-    m_voxelizeLayout = vk::PipelineLayout(ctx, voxelizeSets, sizeof(GpuVoxelGrid));
-    vk::GraphicsPipelineDesc desc;
-    desc.vertexShader = "common/voxelize.vert";
-    desc.geometryShader = "common/voxelize.geom";
-    if (m_fragments) {
-        desc.fragmentShader = m_floatAtomics ? "common/voxelize_fragments.frag"
-                                             : "common/voxel_voxelize_fixed_fragments.frag";
-    } else {
-        desc.fragmentShader =
-            m_floatAtomics ? "common/voxelize.frag" : "common/voxel_voxelize_fixed.frag";
-    }
-    desc.sceneVertexInput = false;  // pulled from the scene set
-    desc.depthTest = false;
-    desc.depthWrite = false;
-    desc.cull = VK_CULL_MODE_NONE;
-    desc.name = "voxel/voxelize";
-    m_voxelize = vk::GraphicsPipeline(ctx, desc, m_voxelizeLayout);
 
     // Resolve.
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -119,7 +122,8 @@ Voxelizer::Voxelizer(vk::Context& ctx, const vk::GpuScene& scene, const VoxelGri
 }
 
 void Voxelizer::record(VkCommandBuffer cmd, vk::GpuTimer* timer) {
-    if (m_accumulators.empty()) throw Error("Voxelizer: accumulators were released");
+    if (!m_fragments && m_accumulators.empty())
+        throw Error("Voxelizer: accumulators were released");
     const uint32_t n = m_grid.resolution();
     const GpuVoxelGrid push = m_grid.gpu(m_floatAtomics ? 0u : 1u);
     {
@@ -132,15 +136,17 @@ void Voxelizer::record(VkCommandBuffer cmd, vk::GpuTimer* timer) {
         if (m_scene.triangleCount() > 0) {
             vk::RenderingScope scope(cmd, {n, n}, {});
             m_voxelize.bind(cmd);
-            VkDescriptorSet sets[3] = {m_scene.set().handle(), m_accumSet.handle(),
-                                       m_fragments ? m_fragments->set().handle() : VK_NULL_HANDLE};
+            VkDescriptorSet sets[2] = {m_scene.set().handle(), m_fragments
+                                                                   ? m_fragments->set().handle()
+                                                                   : m_accumSet.handle()};
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_voxelizeLayout.handle(),
-                                    0, m_fragments ? 3 : 2, sets, 0, nullptr);
+                                    0, 2, sets, 0, nullptr);
             m_voxelizeLayout.push(cmd, push);
             vkCmdDraw(cmd, 3 * m_scene.triangleCount(), 1, 0, 0);
         }
         vk::memoryBarrier(cmd);
     }
+    if (m_fragments) return;  // fragment-list mode: nothing to resolve
     {
         std::optional<vk::ScopedGpuPass> pass;
         if (timer) pass.emplace(*timer, cmd, "voxel_resolve");
@@ -170,6 +176,8 @@ void Voxelizer::run(vk::GpuTimer* timer) {
 }
 
 VoxelData Voxelizer::readVoxels() {
+    if (m_fragments)
+        throw Error("Voxelizer: readVoxels() in fragment-list mode (no volumes); read the lists");
     VoxelData out;
     out.resolution = m_grid.resolution();
     const size_t count = m_grid.voxelCount();

@@ -10,8 +10,9 @@
  * Sums use float atomics when the device has them (Context::hasFloatAtomics), else fixed-point
  * uint atomics (scales and overflow bounds in shaders/common/voxel_grid.glsl).
  * Memory is tagged "voxel/...". After record() the volumes are SHADER_READ_ONLY_OPTIMAL.
- * Optionally (fragmentCapacity > 0) the voxelize pass also appends every voxel fragment to
- * per-voxel linked lists (clustered voxel GI §4.1; core/voxel/voxel_fragments.h).
+ * In fragment-list mode (fragmentCapacity > 0) the voxelize pass instead appends every voxel
+ * fragment to per-voxel linked lists (clustered voxel GI §4.1; core/voxel/voxel_fragments.h);
+ * there are no volumes then (volumes() is empty, readVoxels() throws).
  */
 #include <cstdint>
 #include <memory>
@@ -37,8 +38,9 @@ class GpuTimer;
 struct VoxelizerOptions {
     bool fullPrecision = false;    // RGBA32F volumes instead of RGBA16F
     bool forceFixedPoint = false;  // uint accumulators even with float atomics (tests)
-    /** > 0: also build per-voxel fragment lists (VoxelFragmentLists) with room for this many
-     *  fragments; run() grows the buffer and voxelizes again when a scene needs more. */
+    /** > 0: fragment-list mode: build per-voxel fragment lists (VoxelFragmentLists) with room
+     *  for this many fragments, and no accumulators, volumes or resolve pass (the lists carry
+     *  every fragment). run() grows the buffer and voxelizes again when a scene needs more. */
     uint32_t fragmentCapacity = 0;
 };
 
@@ -91,6 +93,9 @@ public:
     static constexpr uint32_t kAccumulatorWords = 10;
 
 private:
+    /** Accumulators, volumes and the resolve pass (all but fragment-list mode). */
+    void createAccumulation(const VoxelizerOptions& options);
+
     vk::Context& m_ctx;
     const vk::GpuScene& m_scene;
     VoxelGrid m_grid;

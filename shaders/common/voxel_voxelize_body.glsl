@@ -10,6 +10,7 @@
 #include "common/voxel_pc.glsl"
 #include "common/voxel_sat.glsl"
 
+#ifndef VOXEL_FRAGMENT_LISTS
 // One buffer per accumulator word (VOXEL_ACC_WORDS planes of N^3 values), so each binding stays
 // under maxStorageBufferRange (128 MiB on lavapipe) up to 256^3.
 #ifdef VOXEL_FIXED_POINT
@@ -21,41 +22,6 @@ layout(set = 1, binding = 0, std430) buffer VoxelAccumulators {
     float v[];
 } voxelAcc[VOXEL_ACC_WORDS];
 #endif
-
-#ifdef VOXEL_FRAGMENT_LISTS
-// Per-voxel fragment lists (Cosin Ayerbe & Patow 2022 §4.1, Fig. 3; core/voxel/voxel_fragments.h):
-// a linear fragment buffer appended with an atomic counter and one list head per voxel, linked by
-// atomicExchange. Fragments past the capacity are counted, not written (the host re-runs).
-#include "common/voxel_fragments.glsl"
-layout(set = 2, binding = 0, std430) buffer VoxelHeads {
-    uint heads[];
-};
-layout(set = 2, binding = 1, std430) buffer VoxelFragmentBuffer {
-    VoxelFragment fragments[];
-};
-layout(set = 2, binding = 2, std430) buffer VoxelFragmentCounter {
-    uint fragmentCount;
-    uint fragmentCapacity;
-};
-
-void appendFragment(uint voxel, vec3 position, vec3 normal, vec3 albedo) {
-    uint slot = atomicAdd(fragmentCount, 1u);
-    if (slot >= fragmentCapacity) return;
-    uint next = atomicExchange(heads[voxel], slot);
-    fragments[slot] = voxelPackFragment(position, normal, albedo, next);
-}
-#endif
-
-layout(location = 0) flat in uint inTriangle;
-layout(location = 1) flat in uint inAxis;
-layout(location = 2) flat in vec3 inP0;
-layout(location = 3) flat in vec3 inP1;
-layout(location = 4) flat in vec3 inP2;
-layout(location = 5) flat in vec4 inAabb;
-
-const float kEps = 1e-4;  // voxel units: touching within round-off counts as overlap
-
-vec3 swizzleFromAxis(vec3 p, uint a) { return a == 0u ? p.zxy : (a == 1u ? p.yzx : p); }
 
 // Constant plane indices only (no descriptor-array dynamic indexing needed).
 #define VOXEL_ADD3(first, i, value)                  \
@@ -80,6 +46,41 @@ void accumulate(uint i, vec3 albedo, vec3 normal, vec3 emission) {
     atomicAdd(voxelAcc[9].v[i], 1.0);
 #endif
 }
+#else
+// Fragment-list mode (Cosin Ayerbe & Patow 2022 §4.1, Fig. 3; core/voxel/voxel_fragments.h),
+// instead of the accumulators: a linear fragment buffer appended with an atomic counter and one
+// list head per voxel, linked by atomicExchange. Fragments past the capacity are counted, not
+// written (the host re-runs).
+#include "common/voxel_fragments.glsl"
+layout(set = 1, binding = 0, std430) buffer VoxelHeads {
+    uint heads[];
+};
+layout(set = 1, binding = 1, std430) buffer VoxelFragmentBuffer {
+    VoxelFragment fragments[];
+};
+layout(set = 1, binding = 2, std430) buffer VoxelFragmentCounter {
+    uint fragmentCount;
+    uint fragmentCapacity;
+};
+
+void appendFragment(uint voxel, vec3 position, vec3 normal, vec3 albedo) {
+    uint slot = atomicAdd(fragmentCount, 1u);
+    if (slot >= fragmentCapacity) return;
+    uint next = atomicExchange(heads[voxel], slot);
+    fragments[slot] = voxelPackFragment(position, normal, albedo, next);
+}
+#endif
+
+layout(location = 0) flat in uint inTriangle;
+layout(location = 1) flat in uint inAxis;
+layout(location = 2) flat in vec3 inP0;
+layout(location = 3) flat in vec3 inP1;
+layout(location = 4) flat in vec3 inP2;
+layout(location = 5) flat in vec4 inAabb;
+
+const float kEps = 1e-4;  // voxel units: touching within round-off counts as overlap
+
+vec3 swizzleFromAxis(vec3 p, uint a) { return a == 0u ? p.zxy : (a == 1u ? p.yzx : p); }
 
 void main() {
     vec2 lo = floor(gl_FragCoord.xy), hi = lo + 1.0;
@@ -120,8 +121,9 @@ void main() {
         vec3 cell = vec3(lo, float(z));
         if (!voxelTriangleBoxOverlap(cell + 0.5, halfSize, inP0, inP1, inP2)) continue;
         ivec3 c = ivec3(swizzleFromAxis(cell, inAxis));
+#ifndef VOXEL_FRAGMENT_LISTS
         accumulate(voxelLinearIndex(pc.grid, c), baseColor.rgb, normal, emission);
-#ifdef VOXEL_FRAGMENT_LISTS
+#else
         vec3 position = bary.x * v0.position + bary.y * v1.position + bary.z * v2.position;
         appendFragment(voxelLinearIndex(pc.grid, c), position, normal, baseColor.rgb);
 #endif

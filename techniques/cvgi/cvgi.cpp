@@ -95,7 +95,6 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
         lists.grow(fragmentCount);
         voxelize();
     }
-    voxelizer->releaseAccumulators();
     VoxelCompaction compaction(ctx.vk, grid, lists.heads());
     ctx.submitTimed([&](VkCommandBuffer cmd) {
         PassScope pass(ctx, cmd, "prefix_sum");
@@ -109,7 +108,7 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
     cvgi::CompactVoxels voxels;
     ctx.timeCpu("voxel_readback",
                 [&] { voxels = readCompactVoxels(grid, compaction, lists, fragmentCount); });
-    voxelizer.reset();  // fragments, heads and volumes are no longer needed
+    voxelizer.reset();  // the fragments and heads are no longer needed
 
     // §4.2-4.3 on the CPU (docs/techniques/cvgi.md "Where it runs").
     std::vector<uint8_t> axis;
