@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/indirect_energy.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/scene/animation.h"
@@ -153,28 +154,9 @@ TEST_F(GpuCvgi, SpotCornellIndirectIsFiniteAndNearTheOneBounceReference) {
                    defaultSharedParams());
     h.setup();
     h.renderFrame();
-    double cvgi = 0.0;
-    for (const ImageLayer& l : h.readLayers()) {
-        if (l.name != "indirect") continue;
-        for (int y = 0; y < l.image.height(); ++y)
-            for (int x = 0; x < l.image.width(); ++x)
-                for (int c = 0; c < 3; ++c) {
-                    const float v = l.image.at(x, y, c);
-                    ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << x << "," << y;
-                    cvgi += v;
-                }
-    }
-    ref::ReferenceSettings settings;
-    settings.maxBounces = 1;
-    settings.seed = 7;
-    ref::PathTracer tracer(scene, settings);
-    ref::Accumulator acc;
-    acc.reset(scene.settings.width, scene.settings.height);
-    ASSERT_TRUE(tracer.addSamples(acc, 256));
-    double reference = 0.0;
-    const Image bounce = ref::meanImage(acc, ref::Layer::Bounce1);  // named: values() of a
-    for (float v : bounce.values())                                 // temporary would dangle
-        reference += v;
+    const double cvgi = test::indirectLayerSum(h.readLayers());
+    ASSERT_GE(cvgi, 0.0);
+    const double reference = test::oneBounceReferenceSum(scene, 256);
     ASSERT_GT(reference, 0.0);
     std::printf("spot Cornell 32^2, N = 32, 1024 rays: indirect energy cvgi / reference = %.3f\n",
                 cvgi / reference);

@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/indirect_energy.h"
 #include "tests/vct_test_rig.h"
 
 #include "core/gpu/gpu_scene.h"
@@ -341,31 +342,9 @@ TEST_F(GpuVctInjection, AreaLitCornellIndirectIsFiniteAndNearTheReference) {
     for (const auto& p : setup.passes)
         if (p.name.rfind("vct/inject", 0) == 0)
             std::printf("%s %.1f ms\n", p.name.c_str(), p.gpuMs);
-    const Image* indirect = nullptr;
-    for (const ImageLayer& l : layers)
-        if (l.name == "indirect") indirect = &l.image;
-    ASSERT_NE(indirect, nullptr);
-    double vct = 0.0;
-    for (int y = 0; y < indirect->height(); ++y) {
-        for (int x = 0; x < indirect->width(); ++x) {
-            for (int c = 0; c < 3; ++c) {
-                const float v = indirect->at(x, y, c);
-                ASSERT_TRUE(std::isfinite(v) && v >= 0.0f) << x << "," << y;
-                vct += v;
-            }
-        }
-    }
-    ref::ReferenceSettings settings;
-    settings.maxBounces = 1;
-    settings.seed = 7;
-    ref::PathTracer tracer(scene, settings);
-    ref::Accumulator acc;
-    acc.reset(scene.settings.width, scene.settings.height);
-    ASSERT_TRUE(tracer.addSamples(acc, 64));
-    const Image bounce = ref::meanImage(acc, ref::Layer::Bounce1);
-    double reference = 0.0;
-    for (float v : bounce.values())
-        reference += v;
+    const double vct = test::indirectLayerSum(layers);
+    ASSERT_GE(vct, 0.0);
+    const double reference = test::oneBounceReferenceSum(scene, 64);
     ASSERT_GT(reference, 0.0);
     std::printf("area-lit Cornell, 64^2, N = 64: indirect energy vct / reference = %.3f\n",
                 vct / reference);

@@ -38,6 +38,19 @@ DistanceView DistanceView::fromCamera(const Camera& camera, float aspect) {
     return v;
 }
 
+vk::GraphicsPipelineDesc distancePipelineDesc(const std::string& name) {
+    vk::GraphicsPipelineDesc p;
+    p.vertexShader = "common/shadow.vert";
+    p.fragmentShader = "common/shadow.frag";
+    p.sceneVertexInput = false;
+    p.colorFormats = {VK_FORMAT_R32_SFLOAT};
+    p.depthFormat = VK_FORMAT_D32_SFLOAT;
+    p.depthCompare = VK_COMPARE_OP_GREATER;  // reversed-Z
+    p.cull = VK_CULL_MODE_NONE;
+    p.name = name;
+    return p;
+}
+
 DistanceMap::DistanceMap(vk::Context& ctx, const vk::GpuScene& scene, uint32_t width,
                          uint32_t height, const std::string& name)
     : m_scene(scene) {
@@ -59,16 +72,7 @@ DistanceMap::DistanceMap(vk::Context& ctx, const vk::GpuScene& scene, uint32_t w
     m_depth = vk::Image(ctx, depth);
 
     m_layout = vk::PipelineLayout(ctx, {scene.layout().handle()}, sizeof(DistanceView));
-    vk::GraphicsPipelineDesc p;
-    p.vertexShader = "common/shadow.vert";
-    p.fragmentShader = "common/shadow.frag";
-    p.sceneVertexInput = false;
-    p.colorFormats = {VK_FORMAT_R32_SFLOAT};
-    p.depthFormat = VK_FORMAT_D32_SFLOAT;
-    p.depthCompare = VK_COMPARE_OP_GREATER;  // reversed-Z
-    p.cull = VK_CULL_MODE_NONE;
-    p.name = name;
-    m_pipeline = vk::GraphicsPipeline(ctx, p, m_layout);
+    m_pipeline = vk::GraphicsPipeline(ctx, distancePipelineDesc(name), m_layout);
 }
 
 void DistanceMap::record(VkCommandBuffer cmd, const DistanceView& view) {

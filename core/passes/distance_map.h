@@ -39,6 +39,11 @@ struct DistanceView {
 };
 static_assert(sizeof(DistanceView) == 128);
 
+/** The pipeline both the shared shadow maps and DistanceMap draw with: shaders/common/shadow.*,
+ *  R32F distance + D32 reversed-Z depth (GREATER), no culling (thin walls and one-sided quads
+ *  must cast). Push constants: DistanceView (128 bytes). */
+vk::GraphicsPipelineDesc distancePipelineDesc(const std::string& name);
+
 class DistanceMap {
 public:
     static constexpr float kFar = 3.0e38f;

@@ -8,6 +8,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/gpu/gpu_scene.h"
+#include "core/passes/distance_map.h"
 #include "core/util/error.h"
 #include "core/vk/context.h"
 #include "core/vk/rendering.h"
@@ -78,16 +79,8 @@ ShadowMaps::ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettin
     m_sampler = vk::Sampler(ctx, sampler);
 
     m_layout = vk::PipelineLayout(ctx, {scene.layout().handle()}, sizeof(Job::Push));
-    vk::GraphicsPipelineDesc desc;
-    desc.vertexShader = "common/shadow.vert";
-    desc.fragmentShader = "common/shadow.frag";
-    desc.sceneVertexInput = false;
-    desc.colorFormats = {kDistanceFormat};
-    desc.depthFormat = kDepthFormat;
-    desc.depthCompare = VK_COMPARE_OP_GREATER;  // reversed-Z
-    desc.cull = VK_CULL_MODE_NONE;              // thin walls and one-sided quads must cast
-    desc.name = "shared/shadow_maps";
-    m_pipeline = vk::GraphicsPipeline(ctx, desc, m_layout);
+    static_assert(kDistanceFormat == VK_FORMAT_R32_SFLOAT && kDepthFormat == VK_FORMAT_D32_SFLOAT);
+    m_pipeline = vk::GraphicsPipeline(ctx, distancePipelineDesc("shared/shadow_maps"), m_layout);
 }
 
 ShadowMaps::Frame ShadowMaps::sceneFrame() const {

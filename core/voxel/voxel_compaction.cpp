@@ -47,12 +47,17 @@ VoxelCompaction::VoxelCompaction(vk::Context& ctx, const VoxelGrid& grid, const 
     m_fill = vk::ComputePipeline(ctx, "common/voxel_compact_fill.comp", m_fillPipelineLayout);
 }
 
-void VoxelCompaction::recordScan(VkCommandBuffer cmd) {
+void VoxelCompaction::bind(VkCommandBuffer cmd, const vk::PipelineLayout& layout,
+                           const vk::DescriptorSet& set) const {
     const Push push{uint32_t(m_grid.voxelCount()), m_blockCount};
-    VkDescriptorSet set = m_scanSet.handle();
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_scanPipelineLayout.handle(), 0,
-                            1, &set, 0, nullptr);
-    m_scanPipelineLayout.push(cmd, push);
+    VkDescriptorSet handle = set.handle();
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout.handle(), 0, 1, &handle, 0,
+                            nullptr);
+    layout.push(cmd, push);
+}
+
+void VoxelCompaction::recordScan(VkCommandBuffer cmd) {
+    bind(cmd, m_scanPipelineLayout, m_scanSet);
     m_count.bind(cmd);
     vkCmdDispatch(cmd, m_blockCount, 1, 1);
     vk::memoryBarrier(cmd);
@@ -79,11 +84,7 @@ void VoxelCompaction::recordFill(VkCommandBuffer cmd, uint32_t occupied) {
     m_fillSet.writeBuffer(2, m_fragmentIndex);
     m_fillSet.writeBuffer(3, m_hashedPosition);
     m_fillSet.writeBuffer(4, m_voxelIndex);
-    const Push push{uint32_t(m_grid.voxelCount()), m_blockCount};
-    VkDescriptorSet set = m_fillSet.handle();
-    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_fillPipelineLayout.handle(), 0,
-                            1, &set, 0, nullptr);
-    m_fillPipelineLayout.push(cmd, push);
+    bind(cmd, m_fillPipelineLayout, m_fillSet);
     m_fill.bind(cmd);
     vkCmdDispatch(cmd, m_blockCount, 1, 1);
     vk::memoryBarrier(cmd);

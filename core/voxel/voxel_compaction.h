@@ -46,6 +46,9 @@ private:
     struct Push {
         uint32_t voxelCount, blockCount;
     };
+    /** Binds `set` at 0 and pushes the counts (every pass has the same push block). */
+    void bind(VkCommandBuffer cmd, const vk::PipelineLayout& layout,
+              const vk::DescriptorSet& set) const;
 
     vk::Context& m_ctx;
     VoxelGrid m_grid;
