@@ -169,10 +169,14 @@ void Voxelizer::run(vk::GpuTimer* timer) {
         if (timer) timer->reset(cmd);
         record(cmd, timer);
     });
-    if (m_fragments && m_fragments->overflowed()) {
-        m_fragments->grow(m_fragments->written());
+    if (growFragmentsIfOverflowed())
         m_ctx.submitAndWait([&](VkCommandBuffer cmd) { record(cmd, nullptr); });
-    }
+}
+
+bool Voxelizer::growFragmentsIfOverflowed() {
+    if (!m_fragments || !m_fragments->overflowed()) return false;
+    m_fragments->grow(m_fragments->written());
+    return true;
 }
 
 VoxelData Voxelizer::readVoxels() {

@@ -79,6 +79,9 @@ public:
     /** Null unless options.fragmentCapacity > 0. After a run that did not overflow, the lists
      *  hold every fragment (fragments()->overflowed() says otherwise). */
     VoxelFragmentLists* fragments() { return m_fragments.get(); }
+    /** After a finished run in fragment-list mode that overflowed: grows the buffer to the
+     *  counted fragments and returns true (record() must then run again); else false. */
+    bool growFragmentsIfOverflowed();
 
     const VoxelGrid& grid() const { return m_grid; }
     VoxelVolumes& volumes() { return m_volumes; }

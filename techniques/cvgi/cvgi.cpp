@@ -88,13 +88,13 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
         });
     };
     voxelize();
-    const uint32_t fragmentCount = lists.written();
-    if (fragmentCount > lists.capacity()) {
-        ctx.note("fragment buffer grown from " + std::to_string(lists.capacity()) + " to " +
-                 std::to_string(fragmentCount) + " fragments: voxelization ran twice");
-        lists.grow(fragmentCount);
+    const uint32_t firstCapacity = lists.capacity();
+    if (voxelizer->growFragmentsIfOverflowed()) {
+        ctx.note("fragment buffer grown from " + std::to_string(firstCapacity) + " to " +
+                 std::to_string(lists.capacity()) + " fragments: voxelization ran twice");
         voxelize();
     }
+    const uint32_t fragmentCount = lists.written();
     VoxelCompaction compaction(ctx.vk, grid, lists.heads());
     ctx.submitTimed([&](VkCommandBuffer cmd) {
         PassScope pass(ctx, cmd, "prefix_sum");
@@ -152,7 +152,7 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
              " seeds, " + std::to_string(clusters.unassigned) +
              " voxels unassigned (never a source, still occluders); visibility " +
              std::to_string(visibility.clusters.size()) + " entries (" +
-             mib(4.0 * visibility.clusters.size()) + "); bounce + frame buffers " +
+             mib(double(m_gpu->visibilityBytes())) + " with the offsets); bounce + frame buffers " +
              mib(double(m_gpu->finalBytes())));
     ctx.note(std::to_string(m_gpu->emitterCount()) +
              " emitter(s) with a distance map; static geometry assumed (a geometry change "

@@ -71,6 +71,8 @@ public:
     CvgiCounters readCounters();
     /** Bytes of the buffers the bounce and the frame use (the paper's "Mem. Final"). */
     uint64_t finalBytes() const;
+    /** Bytes of the compacted per-face visibility (offsets + cluster ids). */
+    uint64_t visibilityBytes() const { return m_faceOffset.size() + m_faceClusters.size(); }
     uint32_t emitterCount() const { return uint32_t(m_emitters.size()); }
 
 private:
