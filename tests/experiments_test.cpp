@@ -126,6 +126,18 @@ TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
          },
          "more than once"},
         {"bad name", [](auto& j) { j["name"] = "a/b"; }, "name"},
+        // TechniqueInfo::checkParams: cross-parameter rules, found before anything runs.
+        {"even cvgi kernel",
+         [](auto& j) {
+             j["techniques"][0] = {{"technique", "cvgi"},
+                                   {"sweep", {{"grid", {{"gaussian_kernel", {3, 4}}}}}}};
+         },
+         "gaussian_kernel = 4 must be odd"},
+        {"vct resolution not a power of two",
+         [](auto& j) {
+             j["techniques"][0] = {{"technique", "vct"}, {"params", {{"voxel_resolution", 48}}}};
+         },
+         "power of two"},
     };
     for (const Case& c : cases) {
         nlohmann::json j = baseConfig();

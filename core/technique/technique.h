@@ -64,6 +64,10 @@ struct TechniqueInfo {
      *  indirectBounces is then its default. Use claimedBounces() to read it. */
     std::string bouncesParam;
     FeatureSupport supports;
+    /** Optional cross-parameter check (e.g. "gaussian_kernel must be odd") beyond each spec's
+     *  range: throws gilab::Error naming the parameter. Experiment configs call it for every
+     *  sweep point before anything runs; set-up calls it again through the settings parser. */
+    std::function<void(const ParamSet&)> checkParams;
 };
 
 /** The indirect bounces a technique claims with these parameter values (TechniqueInfo). */

@@ -420,6 +420,15 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
                     throw Error(config.path + ": technique \"" + t.id + "\" " +
                                 run.shared.toString() + ": " + e.what());
                 }
+                const TechniqueInfo& info = TechniqueRegistry::instance().get(t.id);
+                if (info.checkParams) {
+                    try {
+                        info.checkParams(run.params);
+                    } catch (const Error& e) {
+                        throw Error(config.path + ": technique \"" + t.id + "\" " +
+                                    run.params.toString() + ": " + e.what());
+                    }
+                }
                 runs.push_back(std::move(run));
             }
         }

@@ -43,6 +43,7 @@ TechniqueInfo CvgiTechnique::describe() {
         "Computers & Graphics 103 (2022), doi 10.1016/j.cag.2022.01.005";
     info.params = cvgiParamSpecs();
     info.indirectBounces = 1;
+    info.checkParams = [](const ParamSet& p) { (void)cvgiSettingsFrom(p); };
     info.supports.pointLights = false;       // would need six distance maps (§5.2)
     info.supports.emissiveSurfaces = false;  // only emitters with a shadow-map camera
     return info;

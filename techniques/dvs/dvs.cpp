@@ -30,6 +30,7 @@ TechniqueInfo DvsTechnique::describe() {
     info.params = dvsParamSpecs();
     info.indirectBounces = 1;
     info.bouncesParam = "bounces";
+    info.checkParams = [](const ParamSet& p) { (void)dvsSettingsFrom(p); };
     // Emitters light the voxels through the shared emitter samples (direct light at the voxel,
     // the source of the first bounce); their raw emission is never gathered (docs/dvs.md).
     info.supports.emissiveSurfaces = true;

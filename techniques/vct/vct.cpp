@@ -61,6 +61,20 @@ std::vector<vk::DescriptorBinding> toBindings(const std::vector<VkDescriptorSetL
     return out;
 }
 
+/** The cross-parameter checks of vct (TechniqueInfo::checkParams). */
+void checkVctParams(const ParamSet& p) {
+    const uint32_t n = uint32_t(p.getInt("voxel_resolution"));
+    if ((n & (n - 1)) != 0) {
+        throw Error("vct: voxel_resolution = " + std::to_string(n) +
+                    " must be a power of two (mip pyramid / octree levels)");
+    }
+    const int mapRes = p.getInt("light_map_resolution");
+    if (mapRes != 0 && mapRes < 8) {
+        throw Error("vct: light_map_resolution = " + std::to_string(mapRes) +
+                    " must be 0 (auto) or >= 8");
+    }
+}
+
 }  // namespace
 
 VctTechnique::VctTechnique() = default;
@@ -140,21 +154,15 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
                    "AO distance falloff lambda in f(r) = 1 / (1 + lambda r) (Crassin §6)"),
     };
+    info.checkParams = checkVctParams;
     return info;
 }
 
 void VctTechnique::setup(TechniqueContext& ctx) {
     const ParamSet& p = ctx.params;
+    checkVctParams(p);
     const uint32_t n = uint32_t(p.getInt("voxel_resolution"));
-    if ((n & (n - 1)) != 0) {
-        throw Error("vct: voxel_resolution = " + std::to_string(n) +
-                    " must be a power of two (mip pyramid / octree levels)");
-    }
     int mapRes = p.getInt("light_map_resolution");
-    if (mapRes != 0 && mapRes < 8) {
-        throw Error("vct: light_map_resolution = " + std::to_string(mapRes) +
-                    " must be 0 (auto) or >= 8");
-    }
     m_octree = p.getEnum("storage") == "octree";
     m_ao = p.getBool("ao");
     if (!ctx.scene.caps.bounds.valid()) throw Error("vct: the scene has no geometry");
