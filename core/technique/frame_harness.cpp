@@ -186,6 +186,7 @@ FrameTiming FrameHarness::renderFrame() {
         m_technique->render(ctx, cmd, targets);
     });
     t.cpuMs = sw.elapsedMs();
+    m_technique->frameFinished(ctx);
     if (timer) t.passes = timer->resolve();
     return t;
 }

@@ -16,6 +16,7 @@
  *                     and is reported as a "full rebuild"
  *   render()          records the per-frame passes into the frame's command buffer; it must write
  *                     the indirect layer (linear HDR radiance, RGBA32F) and may add debug views
+ *   frameFinished()   after the frame's submission: per-frame numbers read back (ctx.stat)
  * The harness owns the shared passes (G-buffer, shadow maps, direct light), the composition
  * final = emission + direct + indirect, timing, read-back, NaN/Inf counting and memory reports.
  */
@@ -177,6 +178,9 @@ public:
     virtual UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes);
     /** Records the frame's passes. Must not submit; the harness submits and waits. */
     virtual void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) = 0;
+    /** Called once the frame's submission has finished: read back small per-frame results
+     *  (e.g. counters) and record them with ctx.stat. Default: nothing. */
+    virtual void frameFinished(TechniqueContext& ctx) { (void)ctx; }
     virtual std::vector<DebugView> debugViews() { return {}; }
 
     const TechniqueInfo& info() const { return m_info; }

@@ -76,10 +76,14 @@ SequenceResult runSequence(FrameHarness& harness, const SequenceInputs& in) {
         o.referenceStdError = &m.finalStdError;
         const nlohmann::ordered_json vsMatched =
             metrics::toJson(metrics::computeMetrics(final, m.final, o));
+        nlohmann::ordered_json stats = nlohmann::ordered_json::object();
+        for (const auto& [name, value] : harness.stats())  // the technique's numbers this frame
+            stats[name] = numberOrNull(value);
         frames.push_back({{"frame", frame},
                           {"time_s", animation.frameTime(frame)},
                           {"final_vs_full", vsFull},
-                          {"final", vsMatched}});
+                          {"final", vsMatched},
+                          {"stats", stats}});
         fullFlip.push_back(vsFull["flip"].value("mean", std::nan("")));
         fullRelMse.push_back(vsFull.value("rel_mse", std::nan("")));
         matchedFlip.push_back(vsMatched["flip"].value("mean", std::nan("")));

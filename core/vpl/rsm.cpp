@@ -1,0 +1,149 @@
+#include "core/vpl/rsm.h"
+
+#include <cmath>
+
+#include "core/gpu/gpu_scene.h"
+#include "core/passes/pass_light.h"
+#include "core/util/error.h"
+#include "core/vk/barrier.h"
+#include "core/vk/buffer.h"
+#include "core/vk/context.h"
+#include "core/vk/rendering.h"
+
+namespace gilab {
+namespace {
+
+struct RsmPush {  // mirrors shaders/common/rsm_pc.glsl
+    glm::mat4 viewProj;
+    glm::vec4 toLight;
+};
+struct VplPush {  // mirrors rsm_vpls.comp
+    glm::vec4 axis;
+    uint32_t light, count, first, perspective;
+};
+
+vk::Image layer(vk::Context& ctx, uint32_t size, VkFormat format, VkImageUsageFlags usage,
+                const std::string& name) {
+    vk::ImageDesc d;
+    d.format = format;
+    d.width = size;
+    d.height = size;
+    d.usage = usage;
+    d.name = name;
+    return vk::Image(ctx, d);
+}
+
+glm::vec3 row(const glm::mat4& m, int r) {
+    return {m[0][r], m[1][r], m[2][r]};
+}
+
+}  // namespace
+
+ReflectiveShadowMap::ReflectiveShadowMap(vk::Context& ctx, const vk::GpuScene& scene,
+                                         const vk::Buffer& passLights, uint32_t size,
+                                         const std::string& tag)
+    : m_scene(scene) {
+    if (size == 0) throw Error(tag + ": empty reflective shadow map");
+    const VkImageUsageFlags color =
+        VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
+    m_position = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.position");
+    m_normal = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.normal");
+    m_albedo = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.albedo");
+    m_depth = layer(ctx, size, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
+                    tag + "/rsm.depth");
+
+    m_rasterLayout = vk::PipelineLayout(ctx, {scene.layout().handle()}, sizeof(RsmPush));
+    vk::GraphicsPipelineDesc p;
+    p.vertexShader = "common/rsm.vert";
+    p.fragmentShader = "common/rsm.frag";
+    p.sceneVertexInput = false;
+    p.colorFormats.assign(3, VK_FORMAT_R32G32B32A32_SFLOAT);
+    p.depthFormat = VK_FORMAT_D32_SFLOAT;
+    p.depthCompare = VK_COMPARE_OP_GREATER;  // reversed-Z light views (light_view.h)
+    p.cull = VK_CULL_MODE_NONE;
+    p.name = tag + "/rsm";
+    m_raster = vk::GraphicsPipeline(ctx, p, m_rasterLayout);
+
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    m_setLayout = vk::DescriptorSetLayout(ctx,
+                                          {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                           {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                           {2, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
+                                           {3, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs},
+                                           {4, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs}},
+                                          tag + "/rsm_vpls");
+    m_set = vk::DescriptorSet(ctx, m_setLayout, 0, tag + "/rsm_vpls");
+    m_set.writeStorageImage(0, m_position.view());
+    m_set.writeStorageImage(1, m_normal.view());
+    m_set.writeStorageImage(2, m_albedo.view());
+    m_set.writeBuffer(3, passLights);
+    m_vplLayout = vk::PipelineLayout(ctx, {m_setLayout.handle()}, sizeof(VplPush));
+    m_vpls = vk::ComputePipeline(ctx, "common/rsm_vpls.comp", m_vplLayout);
+}
+
+bool ReflectiveShadowMap::supports(const PassLight& light) {
+    return uint32_t(light.shadow.x) == kShadowMap2D &&
+           (uint32_t(light.positionType.w) == kPassLightSpot ||
+            uint32_t(light.positionType.w) == kPassLightDirectional);
+}
+
+void ReflectiveShadowMap::record(VkCommandBuffer cmd, const PassLight& entry, uint32_t light) {
+    if (!supports(entry))
+        throw Error("reflective shadow map: pass light " + std::to_string(light) +
+                    " is not a spot or directional light with a 2D view");
+    const bool directional = uint32_t(entry.positionType.w) == kPassLightDirectional;
+    RsmPush push{entry.viewProj, directional ? glm::vec4(-glm::vec3(entry.direction), 1.0f)
+                                             : glm::vec4(glm::vec3(entry.positionType), 0.0f)};
+    // Texel footprint (docs/vpl.md): the view maps a texel to 2 / (W |r0|) x 2 / (H |r1|) on the
+    // plane at unit distance (perspective, scaled by |r3|^2) or in the world (orthographic).
+    const glm::mat4& vp = entry.viewProj;
+    const float n = float(size());
+    const float s = directional ? 1.0f : glm::length(row(vp, 3));
+    const float area = 4.0f * s * s / (n * n * glm::length(row(vp, 0)) * glm::length(row(vp, 1)));
+    m_axis = glm::vec4(directional ? glm::vec3(entry.direction) : row(vp, 3) / s, area);
+    m_light = light;
+    m_perspective = !directional;
+
+    for (vk::Image* img : {&m_position, &m_normal, &m_albedo})
+        img->transition(cmd, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
+    m_depth.transition(cmd, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
+    {
+        const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
+        vk::DepthTarget depth;
+        depth.view = m_depth.view();
+        depth.clear = 0.0f;  // reversed-Z
+        depth.store = false;
+        vk::RenderingScope scope(
+            cmd, m_position.extent2D(),
+            {{m_position.view(), zero}, {m_normal.view(), zero}, {m_albedo.view(), zero}}, depth);
+        if (m_scene.triangleCount() > 0) {
+            m_raster.bind(cmd);
+            VkDescriptorSet set = m_scene.set().handle();
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_rasterLayout.handle(),
+                                    0, 1, &set, 0, nullptr);
+            m_rasterLayout.push(cmd, push);
+            vkCmdDraw(cmd, 3 * m_scene.triangleCount(), 1, 0, 0);
+        }
+    }
+    for (vk::Image* img : {&m_position, &m_normal, &m_albedo})
+        img->transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
+}
+
+void ReflectiveShadowMap::recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls, uint32_t first,
+                                     uint32_t count) {
+    if (count == 0) return;
+    if (vpls.handle() != m_boundVpls) {  // synchronous submissions: safe to rewrite
+        m_set.writeBuffer(4, vpls);
+        m_boundVpls = vpls.handle();
+    }
+    m_vpls.bind(cmd);
+    VkDescriptorSet set = m_set.handle();
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_vplLayout.handle(), 0, 1, &set,
+                            0, nullptr);
+    const VplPush push{m_axis, m_light, count, first, m_perspective ? 1u : 0u};
+    m_vplLayout.push(cmd, push);
+    vk::dispatch1D(cmd, count, 64);
+    vk::memoryBarrier(cmd);
+}
+
+}  // namespace gilab

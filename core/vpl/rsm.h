@@ -1,0 +1,69 @@
+#pragma once
+/**
+ * Reflective shadow map (Dachsbacher & Stamminger 2005) of one light and the first-bounce VPLs
+ * drawn from it, for the VPL techniques (docs/vpl.md).
+ *
+ * The RSM is rendered with the light's 2D view from the pass light table (spot: perspective over
+ * the outer cone; directional: orthographic over the scene's bounding sphere; the same views as
+ * the shadow maps), at its own resolution, apart from the direct-light shadow maps (Aranha et al.
+ * §III-A: "shadow map and RSM generation are decoupled"). Layers (RGBA32F, GENERAL after record):
+ * position, normal (on the light's side), albedo; background texels are 0.
+ *
+ * recordVpls() draws n VPLs at the fixed Hammersley points (Eq. 1) with flux in watts from the
+ * texel's area (directional) or solid angle (spot): see shaders/common/rsm_vpls.comp.
+ */
+#include <cstdint>
+#include <string>
+
+#include <vulkan/vulkan.h>
+#include <glm/glm.hpp>
+
+#include "core/vk/descriptors.h"
+#include "core/vk/image.h"
+#include "core/vk/pipeline.h"
+
+namespace gilab {
+namespace vk {
+class Buffer;
+class Context;
+class GpuScene;
+}  // namespace vk
+struct PassLight;
+
+class ReflectiveShadowMap {
+public:
+    /** passLights: the pass light table buffer (ShadowMaps::lightBuffer()). */
+    ReflectiveShadowMap(vk::Context& ctx, const vk::GpuScene& scene, const vk::Buffer& passLights,
+                        uint32_t size, const std::string& tag);
+    ReflectiveShadowMap(const ReflectiveShadowMap&) = delete;
+    ReflectiveShadowMap& operator=(const ReflectiveShadowMap&) = delete;
+
+    /** True when the pass light has a 2D view an RSM can use (spot <= 85 deg, directional). */
+    static bool supports(const PassLight& light);
+    /** Renders the RSM of pass light `light` (whose table entry is `entry`). */
+    void record(VkCommandBuffer cmd, const PassLight& entry, uint32_t light);
+    /** Writes `count` VPLs from the last record() to vpls[first ...] (bounce 1, unshadowed). */
+    void recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls, uint32_t first, uint32_t count);
+
+    vk::Image& position() { return m_position; }
+    vk::Image& normal() { return m_normal; }
+    vk::Image& albedo() { return m_albedo; }
+    uint32_t size() const { return m_position.width(); }
+
+private:
+    const vk::GpuScene& m_scene;
+    vk::Image m_position, m_normal, m_albedo, m_depth;
+    vk::PipelineLayout m_rasterLayout;
+    vk::GraphicsPipeline m_raster;
+    vk::DescriptorSetLayout m_setLayout;
+    vk::DescriptorSet m_set;
+    vk::PipelineLayout m_vplLayout;
+    vk::ComputePipeline m_vpls;
+    VkBuffer m_boundVpls = VK_NULL_HANDLE;
+    // From the last record(): the sampling push constants.
+    glm::vec4 m_axis{0.0f};
+    uint32_t m_light = 0;
+    bool m_perspective = false;
+};
+
+}  // namespace gilab

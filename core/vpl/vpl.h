@@ -1,0 +1,30 @@
+#pragma once
+/**
+ * The shared VPL module (docs/vpl.md): virtual point lights and their clusters as the GPU stores
+ * them. Mirrors Vpl / VplCluster in shaders/common/vpl.glsl (std430). Used by `ssvp` (Aranha et
+ * al.) and meant for every VPL technique (topological VPLs, instant radiosity).
+ *
+ * Units (docs/conventions.md): a VPL carries a flux [W]; it is a cosine emitter with intensity
+ * I(w) = flux max(0, n.w) / pi [W/sr], so a receiver at distance d gets the irradiance
+ * E = flux cos(theta) cos(sigma) / (pi d^2) [W/m^2].
+ */
+#include <glm/glm.hpp>
+
+namespace gilab {
+
+struct GpuVpl {
+    glm::vec4 position{0.0f};  // xyz world, w 1 = valid
+    glm::vec4 normal{0.0f};    // xyz unit normal, w visibility map layer (-1 = unshadowed)
+    glm::vec4 flux{0.0f};      // rgb W, w bounce
+};
+static_assert(sizeof(GpuVpl) == 48);
+
+struct GpuVplCluster {
+    glm::vec4 position{0.0f};  // xyz map eye, w 1 = active
+    glm::vec4 normal{0.0f};    // xyz unit axis, w member count
+    glm::vec4 flux{0.0f};      // rgb summed member flux
+    glm::vec4 mean{0.0f};      // xyz member mean (before the eye offset)
+};
+static_assert(sizeof(GpuVplCluster) == 64);
+
+}  // namespace gilab

@@ -1,0 +1,81 @@
+#pragma once
+/**
+ * C++ mirror of the sampling and paraboloid mathematics in shaders/common/vpl.glsl, for the CPU
+ * tests and for host-side checks. Keep the two in step.
+ */
+#include <cmath>
+#include <cstdint>
+
+#include <glm/glm.hpp>
+
+namespace gilab::vpl {
+
+inline constexpr float kPi = 3.14159265358979323846f;
+
+/** Base-2 radical inverse (Van der Corput) of k. */
+inline float radicalInverse(uint32_t k) {
+    k = (k << 16u) | (k >> 16u);
+    k = ((k & 0x55555555u) << 1u) | ((k & 0xAAAAAAAAu) >> 1u);
+    k = ((k & 0x33333333u) << 2u) | ((k & 0xCCCCCCCCu) >> 2u);
+    k = ((k & 0x0F0F0F0Fu) << 4u) | ((k & 0xF0F0F0F0u) >> 4u);
+    k = ((k & 0x00FF00FFu) << 8u) | ((k & 0xFF00FF00u) >> 8u);
+    return float(double(k) * 2.3283064365386963e-10);
+}
+
+/** Aranha et al. Eq. 1: Hammersley point k of n. */
+inline glm::vec2 hammersley(uint32_t k, uint32_t n) {
+    return {float(k) / float(n), radicalInverse(k)};
+}
+
+/** Shirley-Chiu concentric square-to-disk map (uniform in area). */
+inline glm::vec2 concentricDisk(glm::vec2 u) {
+    const glm::vec2 o = 2.0f * u - 1.0f;
+    if (o.x == 0.0f && o.y == 0.0f) return {0.0f, 0.0f};
+    float r, phi;
+    if (std::abs(o.x) > std::abs(o.y)) {
+        r = o.x;
+        phi = 0.25f * kPi * (o.y / o.x);
+    } else {
+        r = o.y;
+        phi = 0.5f * kPi - 0.25f * kPi * (o.x / o.y);
+    }
+    return r * glm::vec2(std::cos(phi), std::sin(phi));
+}
+
+/** Rows t, b, n of an orthonormal frame around unit n (Duff et al. 2017). */
+inline glm::mat3 frame(const glm::vec3& n) {
+    const float s = n.z >= 0.0f ? 1.0f : -1.0f;
+    const float a = -1.0f / (s + n.z);
+    const float b = n.x * n.y * a;
+    const glm::vec3 t(1.0f + s * n.x * n.x * a, s * b, -s * n.x);
+    const glm::vec3 bt(b, s + n.y * n.y * a, -n.y);
+    return glm::transpose(glm::mat3(t, bt, n));
+}
+
+/** Paraboloid projection of a unit local direction with d.z >= 0 onto the unit disk. */
+inline glm::vec2 paraboloidProject(const glm::vec3& d) {
+    return glm::vec2(d.x, d.y) / (1.0f + d.z);
+}
+/** Its inverse: the unit direction of a disk point. */
+inline glm::vec3 paraboloidDirection(const glm::vec2& p) {
+    const float r2 = glm::dot(p, p);
+    return glm::vec3(2.0f * p.x, 2.0f * p.y, 1.0f - r2) / (1.0f + r2);
+}
+/** Solid angle per unit disk area at disk point p: 4 / (1 + r^2)^2. */
+inline float paraboloidSolidAngleDensity(const glm::vec2& p) {
+    const float q = 1.0f + glm::dot(p, p);
+    return 4.0f / (q * q);
+}
+
+/**
+ * Flux weight of a second-bounce VPL sampled uniformly on the unit disk of a cluster's map
+ * (docs/techniques/ssvp.md "Weighting"): cosine emission of the cluster over the disk density,
+ * 4 (1 - r^2) / (1 + r^2)^3 per sample of M; its mean over the disk is 1.
+ */
+inline float diskSampleWeight(const glm::vec2& p) {
+    const float r2 = glm::dot(p, p);
+    const float q = 1.0f + r2;
+    return 4.0f * (1.0f - r2) / (q * q * q);
+}
+
+}  // namespace gilab::vpl

@@ -1,0 +1,132 @@
+#!/usr/bin/env python3
+"""Prints ssvp's paper-shaped tables (Aranha et al., Table I and the Fig. 6 comparison) from a
+results folder:
+
+  Table I   per-stage GPU ms: G-buffer (the shared pass), misc (RSM, first-bounce VPLs, K-means,
+            second-bounce VPLs), paraboloid, shade (gathering + blur), total; per cluster count
+  error     each run against the two-bounce reference (what ssvp claims) and the full one:
+            relMSE and mean HDR-FLIP, the clamp's removed energy, the K-means iterations
+  relative  the paper's own comparison: every run against the C = 32 run with the same other
+            parameters (the paper: HDR-VDP-2 RMSE; here relMSE and HDR-FLIP via `gilab compare`)
+
+    python3 scripts/ssvp_tables.py results/ssvp_paper [path/to/gilab]
+
+Standard library only; the relative table needs the gilab binary (default build/gilab).
+"""
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+STAGES = ["gbuffer", "misc", "paraboloid", "shade"]
+
+
+def stage_ms(result):
+    """Median GPU ms per Table I stage (passes summed by their stage prefix)."""
+    out = {k: 0.0 for k in STAGES}
+    out["direct"] = 0.0
+    for p in result.get("timing", {}).get("passes", []):
+        name, ms = p["name"], (p.get("gpu_ms") or {}).get("median")
+        if ms is None:
+            continue
+        if name == "gbuffer":
+            out["gbuffer"] += ms
+        elif name == "direct_light":
+            out["direct"] += ms
+        elif name.startswith("ssvp/"):
+            stage = name[5:].split(".")[0]
+            if stage in out:
+                out[stage] += ms
+    return out
+
+
+def fmt(v, digits=2):
+    return "-" if v is None else f"{v:.{digits}f}"
+
+
+def metric(r, group, name):
+    m = r.get("metrics", {}).get(group, {})
+    v = m.get(name)
+    return v.get("mean") if isinstance(v, dict) else v
+
+
+def key_without(params, drop):
+    return tuple(sorted((k, str(v)) for k, v in params.items() if k != drop))
+
+
+def relative(rows, folder, gilab):
+    """Each run against the C = 32 run of the same scene and other parameters."""
+    refs = {}
+    for r in rows:
+        p = r["technique"]["params"]
+        if p["clusters"] == 32:
+            refs[(r["scene"]["label"], key_without(p, "clusters"))] = r
+    lines = []
+    for r in rows:
+        p = r["technique"]["params"]
+        ref = refs.get((r["scene"]["label"], key_without(p, "clusters")))
+        if ref is None or ref is r:
+            continue
+        a = Path(folder) / "runs" / r["key"] / "output.exr"
+        b = Path(folder) / "runs" / ref["key"] / "output.exr"
+        try:
+            out = subprocess.run([gilab, "compare", f"{a}:final", f"{b}:final", "--json",
+                                  "--metrics", "relmse,hdr-flip"],
+                                 check=True, capture_output=True, text=True).stdout
+            m = json.loads(out)["metrics"]
+        except (OSError, subprocess.CalledProcessError, json.JSONDecodeError) as e:
+            lines.append(f"{r['scene']['label']}\t{p['clusters']}\t{p['second_bounce_vpls']}\t"
+                         f"compare failed: {e}")
+            continue
+        flip = m.get("flip") or {}
+        lines.append("\t".join([r["scene"]["label"], str(p["clusters"]),
+                                str(p["second_bounce_vpls"]), fmt(m.get("rel_mse"), 4),
+                                fmt(flip.get("mean") if isinstance(flip, dict) else flip, 4)]))
+    return lines
+
+
+def main(folder, gilab):
+    rows = []
+    for path in sorted((Path(folder) / "runs").glob("*/result.json")):
+        r = json.loads(path.read_text())
+        if r.get("technique", {}).get("id") == "ssvp" and r.get("status") == "ok":
+            rows.append(r)
+    if not rows:
+        sys.exit(f"{folder}: no finished ssvp runs")
+    rows.sort(key=lambda r: (r["scene"]["label"], r["technique"]["params"]["second_bounce_vpls"],
+                             r["technique"]["params"]["clusters"]))
+    device = rows[0].get("device", {}).get("name", "?")
+    print(f"Table I (median GPU ms per stage; device: {device})")
+    print("\t".join(["scene", "C", "N2"] + STAGES + ["total", "direct (not in Table I)"]))
+    for r in rows:
+        p = r["technique"]["params"]
+        ms = stage_ms(r)
+        total = sum(ms[k] for k in STAGES)
+        print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"])] +
+                        [fmt(ms[k]) for k in STAGES] + [fmt(total), fmt(ms["direct"])]))
+    print("\nError (final image) against the two-bounce reference and the full one")
+    print("\t".join(["scene", "C", "N2", "relMSE_2b", "HDR-FLIP_2b", "relMSE_full",
+                     "HDR-FLIP_full", "energy_ratio", "clamped_%", "kmeans_it", "valid_vpls"]))
+    for r in rows:
+        p = r["technique"]["params"]
+        s = r.get("stats", {})
+        print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
+                         fmt(metric(r, "final", "rel_mse"), 4), fmt(metric(r, "final", "flip"), 4),
+                         fmt(metric(r, "final_vs_full", "rel_mse"), 4),
+                         fmt(metric(r, "final_vs_full", "flip"), 4),
+                         fmt(r.get("metrics", {}).get("energy_ratio"), 3),
+                         fmt(s.get("clamped_energy_percent"), 2), fmt(s.get("kmeans_iterations"), 0),
+                         fmt(s.get("valid_first_bounce_vpls"), 0)]))
+    lines = relative(rows, folder, gilab)
+    if lines:
+        print("\nRelative to C = 32 (the paper's Fig. 6 comparison; paper HDR-VDP-2 RMSE: "
+              "C = 4 0.1259, 8 0.1020, 16 0.0806)")
+        print("\t".join(["scene", "C", "N2", "relMSE_vs_C32", "HDR-FLIP_vs_C32"]))
+        for line in lines:
+            print(line)
+
+
+if __name__ == "__main__":
+    if len(sys.argv) not in (2, 3):
+        sys.exit(__doc__)
+    main(sys.argv[1], sys.argv[2] if len(sys.argv) == 3 else "build/gilab")

@@ -1,0 +1,51 @@
+// K-means over the first-bounce VPLs (techniques/ssvp/ssvp_kmeans.h; Aranha et al. §III-B).
+// Bindings and push constants shared by kmeans_seed/assign/update.comp and second_bounce.comp.
+#ifndef GILAB_SSVP_KMEANS_GLSL
+#define GILAB_SSVP_KMEANS_GLSL
+#include "common/vpl.glsl"
+
+layout(set = 0, binding = 0, std430) buffer Vpls { Vpl vpls[]; };
+layout(set = 0, binding = 1, std430) buffer Clusters { VplCluster clusters[]; };
+layout(set = 0, binding = 2, std430) buffer KmeansState {
+    uint changed;     // assignments changed by the last assign pass
+    uint iterations;  // update passes run this frame
+    uint converged;   // 1: no assignment changed, the remaining passes return at once
+    uint seeded;      // 1: the clusters hold a warm start from an earlier frame
+    uint reseeded;    // empty clusters re-seeded this frame
+    uint activeClusters;  // clusters with members after the last update (= maps rendered)
+    uint assigned;    // VPLs in those clusters (the valid first-bounce VPLs)
+    uint pad0;
+} state;
+
+layout(push_constant, std430) uniform KmeansPush {
+    float positionWeight;  // w1 (Eq. 2)
+    float normalWeight;    // w2
+    float invDiagonal;     // positions are compared in units of the scene diagonal
+    float eyeOffset;       // map eye = centroid + offset x normal (world units)
+    uint count;            // first-bounce VPLs
+    uint clusterCount;     // C
+    uint iteration;        // this pass's iteration (0-based)
+    uint metric;           // 0 corrected: w2 (1 - (n_i.n_j)+); 1 literal: w2 (n_i.n_j)+
+    uint seed;             // first-frame seeding
+    uint secondCount;      // second-bounce VPLs (second_bounce.comp)
+    uint perCluster;       // second-bounce VPLs per cluster M = N2 / C
+    uint paperWeights;     // 1: Eq. 6's constant phi (weights = paper)
+    uint secondVisibility; // 1: second-bounce VPLs take the nearest cluster's map
+    uint mapResolution;
+    uint eyeAtVpl;         // 1: the map's eye is the member VPL nearest the centroid
+    uint pad0;
+} pc;
+
+// Eq. 2 with the position term over the scene diagonal (notes 002 §9). As printed the normal
+// term rewards dissimilar normals; the corrected form uses the dissimilarity 1 - (n_i.n_j)+.
+float kmeansDistance(vec3 p, vec3 n, vec3 center, vec3 centerNormal) {
+    float cosine = max(dot(n, centerNormal), 0.0);
+    float normalTerm = pc.metric == 1u ? cosine : 1.0 - cosine;
+    return pc.positionWeight * length(p - center) * pc.invDiagonal +
+           pc.normalWeight * normalTerm;
+}
+
+bool vplValid(uint i) { return vpls[i].position.w > 0.5; }
+bool clusterSeeded(uint j) { return clusters[j].mean.w > 0.5; }
+
+#endif  // GILAB_SSVP_KMEANS_GLSL

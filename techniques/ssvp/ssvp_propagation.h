@@ -1,0 +1,65 @@
+#pragma once
+/**
+ * The VPL clustering and propagation steps of `ssvp` (Aranha et al. §III-B, §III-C), on the GPU:
+ *   recordClustering      K-means over the N1 first-bounce VPLs: seed (first frame), then per
+ *                         iteration an assignment dispatch and an update dispatch
+ *                         (shaders/ssvp/kmeans_*.comp), warm-started from the previous frame's
+ *                         centroids, stopping on convergence or after the iteration cap
+ *   recordSecondBounce    N2 / C VPLs per cluster from its paraboloid map (second_bounce.comp)
+ * readState() gives the last frame's iteration count and re-seeded clusters once it finished.
+ */
+#include <cstdint>
+#include <string>
+
+#include <vulkan/vulkan.h>
+
+#include "core/vk/buffer.h"
+#include "core/vk/descriptors.h"
+#include "core/vk/pipeline.h"
+#include "techniques/ssvp/ssvp_settings.h"
+
+namespace gilab {
+namespace vk {
+class Context;
+}  // namespace vk
+class ParaboloidMaps;
+
+struct SsvpKmeansState {
+    uint32_t iterations = 0;  // update passes run in the last frame
+    bool converged = false;
+    uint32_t reseeded = 0;  // empty clusters re-seeded in the last frame
+    uint32_t active = 0;    // clusters with members (paraboloid maps rendered)
+    uint32_t assigned = 0;  // valid first-bounce VPLs in them
+};
+
+class SsvpPropagation {
+public:
+    SsvpPropagation(vk::Context& ctx, const vk::Buffer& vpls, const vk::Buffer& clusters,
+                    ParaboloidMaps& maps, const std::string& tag);
+    SsvpPropagation(const SsvpPropagation&) = delete;
+    SsvpPropagation& operator=(const SsvpPropagation&) = delete;
+
+    /** sceneDiagonal: the unit of the position term of Eq. 2 and of the eye offset. */
+    void setSettings(const SsvpSettings& settings, float sceneDiagonal);
+    void recordClustering(VkCommandBuffer cmd);
+    void recordSecondBounce(VkCommandBuffer cmd);
+    SsvpKmeansState readState();
+
+private:
+    struct Push {  // mirrors KmeansPush in shaders/ssvp/kmeans_common.glsl
+        float positionWeight, normalWeight, invDiagonal, eyeOffset;
+        uint32_t count, clusterCount, iteration, metric, seed, secondCount, perCluster,
+            paperWeights, secondVisibility, mapResolution, eyeAtVpl, pad0;
+    };
+    void bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline);
+
+    SsvpSettings m_settings;
+    Push m_push{};
+    vk::Buffer m_state;
+    vk::DescriptorSetLayout m_setLayout;
+    vk::DescriptorSet m_set;
+    vk::PipelineLayout m_layout;
+    vk::ComputePipeline m_seed, m_assign, m_update, m_second;
+};
+
+}  // namespace gilab

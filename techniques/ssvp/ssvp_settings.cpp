@@ -1,0 +1,106 @@
+#include "techniques/ssvp/ssvp_settings.h"
+
+#include <string>
+
+#include "core/util/error.h"
+
+namespace gilab {
+namespace {
+
+constexpr ParamStage kRebuild = ParamStage::Rebuild;
+
+}  // namespace
+
+std::vector<ParamSpec> ssvpParamSpecs() {
+    return {
+        intParam("first_bounce_vpls", 256, 1, 4096, "",
+                 "N1 first-bounce VPLs from the RSM, Hammersley pattern (paper 256)", kRebuild),
+        intParam("second_bounce_vpls", 256, 0, 8192, "",
+                 "N2 second-bounce VPLs in all, N2 / C per cluster (paper 64, 256, 1024)",
+                 kRebuild),
+        intParam("clusters", 8, 1, 64, "",
+                 "C K-means clusters = paraboloid maps (paper 4, 8, 16, 32; 8 recommended)",
+                 kRebuild),
+        intParam("paraboloid_resolution", 256, 16, 2048, "texels",
+                 "paraboloid map side (paper 256; authors' code 1024)", kRebuild),
+        intParam("rsm_resolution", 512, 16, 4096, "texels",
+                 "reflective shadow map side (not given; authors' code 2048)", kRebuild),
+        intParam("kmeans_seed", 1, 0, 1000000000, "",
+                 "seed of the first frame's random centroid VPLs", kRebuild),
+        intParam("light", -1, -1, 1024, "",
+                 "scene light index of the main light (-1 = the first spot or directional)",
+                 kRebuild),
+        intParam("bounces", 2, 1, 2, "", "indirect bounces: 1 = first-bounce VPLs only, 2 = both"),
+        floatParam("kmeans_position_weight", 0.6, 0.0, 100.0, "",
+                   "w1 of Eq. 2, on distances in scene diagonals (paper 0.6; code 1.0)"),
+        floatParam("kmeans_normal_weight", 0.4, 0.0, 100.0, "",
+                   "w2 of Eq. 2 (paper 0.4; code 0.2)"),
+        intParam("kmeans_iterations", 5, 1, 64, "",
+                 "K-means iterations at most per frame; stops early on convergence (paper <= 5)"),
+        enumParam("kmeans_metric", "corrected", {"corrected", "literal"},
+                  "Eq. 2 normal term: corrected w2 (1 - (n.n)+) | literal w2 (n.n)+ as printed "
+                  "(sign-inverted)"),
+        intParam("paraboloid_max_subdivision", 4, 1, 4, "",
+                 "most splits per triangle edge in the paraboloid geometry shader (1 = none)"),
+        floatParam("paraboloid_max_edge_deg", 15.0, 1.0, 180.0, "deg",
+                   "split triangles until each edge subtends at most this from the eye"),
+        floatParam("centroid_offset", 0.001, 0.0, 0.1, "scene diagonals",
+                   "paraboloid eye = centroid + offset x cluster normal (notes 002 §9)"),
+        enumParam("map_eye", "centroid", {"centroid", "nearest_vpl"},
+                  "paraboloid map eye: the cluster centroid (paper) | the member VPL nearest "
+                  "to it (never inside geometry or in the air)"),
+        intParam("interleave", 4, 1, 16, "pixels",
+                 "interleaved shading pattern I x I (paper 4; authors' code 2)"),
+        intParam("blur_radius", 4, 0, 16, "pixels",
+                 "edge-aware Gaussian radius, sigma = radius / 2 (0 = no blur; not given)"),
+        floatParam("clamp_distance", 0.01, 0.0, 1.0, "scene diagonals",
+                   "near-VPL clamp: 1/d^2 uses max(d, this); 0 = no clamp (the paper has none)"),
+        floatParam("visibility_bias_texels", 1.5, 0.0, 1000.0, "texels",
+                   "paraboloid visibility tolerance, in map texels at the receiver"),
+        enumParam("weights", "physical", {"physical", "paper"},
+                  "physical: flux per VPL from its sampling density, 1/N per bounce | paper: "
+                  "Eq. 6 equal weights over N1 + N2 (not energy-consistent)"),
+        enumParam("second_bounce_visibility", "none", {"none", "cluster"},
+                  "second-bounce VPLs unshadowed (the paper as read) | tested against the "
+                  "nearest cluster's map"),
+    };
+}
+
+SsvpSettings ssvpSettingsFrom(const ParamSet& p) {
+    SsvpSettings s;
+    s.firstBounceVpls = uint32_t(p.getInt("first_bounce_vpls"));
+    s.secondBounceVpls = uint32_t(p.getInt("second_bounce_vpls"));
+    s.clusters = uint32_t(p.getInt("clusters"));
+    s.paraboloidResolution = uint32_t(p.getInt("paraboloid_resolution"));
+    s.rsmResolution = uint32_t(p.getInt("rsm_resolution"));
+    s.kmeansSeed = uint32_t(p.getInt("kmeans_seed"));
+    s.light = int(p.getInt("light"));
+    s.bounces = int(p.getInt("bounces"));
+    s.positionWeight = float(p.getFloat("kmeans_position_weight"));
+    s.normalWeight = float(p.getFloat("kmeans_normal_weight"));
+    s.kmeansIterations = uint32_t(p.getInt("kmeans_iterations"));
+    s.literalMetric = p.getEnum("kmeans_metric") == "literal";
+    s.maxSubdivision = uint32_t(p.getInt("paraboloid_max_subdivision"));
+    s.maxEdgeDeg = float(p.getFloat("paraboloid_max_edge_deg"));
+    s.centroidOffset = float(p.getFloat("centroid_offset"));
+    s.eyeAtNearestVpl = p.getEnum("map_eye") == "nearest_vpl";
+    s.interleave = uint32_t(p.getInt("interleave"));
+    s.blurRadius = uint32_t(p.getInt("blur_radius"));
+    s.clampDistance = float(p.getFloat("clamp_distance"));
+    s.visibilityBiasTexels = float(p.getFloat("visibility_bias_texels"));
+    s.paperWeights = p.getEnum("weights") == "paper";
+    s.secondBounceVisibility = p.getEnum("second_bounce_visibility") == "cluster";
+    if (s.secondBounceVpls % s.clusters != 0) {
+        throw Error("ssvp: second_bounce_vpls = " + std::to_string(s.secondBounceVpls) +
+                    " must be a multiple of clusters = " + std::to_string(s.clusters) +
+                    " (N2 / C second-bounce VPLs per cluster, Fig. 5)");
+    }
+    if (s.firstBounceVpls < s.clusters) {
+        throw Error("ssvp: first_bounce_vpls = " + std::to_string(s.firstBounceVpls) +
+                    " is below clusters = " + std::to_string(s.clusters) +
+                    ": K-means needs at least one VPL per cluster");
+    }
+    return s;
+}
+
+}  // namespace gilab

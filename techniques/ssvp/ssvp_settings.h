@@ -1,0 +1,47 @@
+#pragma once
+/**
+ * Parameters of `ssvp` (screen-space VPL propagation, Aranha, Macedo & Apolinario; notes 002)
+ * and their parsed form. Defaults are the paper's where it gives them; every other choice is in
+ * docs/techniques/ssvp.md.
+ */
+#include <cstdint>
+#include <vector>
+
+#include "core/params/params.h"
+
+namespace gilab {
+
+struct SsvpSettings {
+    // Buffers and maps (Rebuild).
+    uint32_t firstBounceVpls = 256;   // N1 (§III-A)
+    uint32_t secondBounceVpls = 256;  // N2 (§IV-A)
+    uint32_t clusters = 8;            // C (§V: 8 recommended)
+    uint32_t paraboloidResolution = 256;
+    uint32_t rsmResolution = 512;
+    uint32_t kmeansSeed = 1;
+    int light = -1;  // scene light index of the main light; -1 = the first spot or directional
+    // Per frame.
+    int bounces = 2;
+    float positionWeight = 0.6f;  // w1 (Eq. 2)
+    float normalWeight = 0.4f;    // w2
+    uint32_t kmeansIterations = 5;
+    bool literalMetric = false;  // Eq. 2 as printed (sign-inverted normal term)
+    uint32_t maxSubdivision = 4;
+    float maxEdgeDeg = 15.0f;
+    float centroidOffset = 0.001f;  // x scene diagonal
+    bool eyeAtNearestVpl = false;   // map_eye = nearest_vpl
+    uint32_t interleave = 4;
+    uint32_t blurRadius = 4;
+    float clampDistance = 0.01f;  // x scene diagonal; 0 = no clamp
+    float visibilityBiasTexels = 1.5f;
+    bool paperWeights = false;
+    bool secondBounceVisibility = false;
+
+    uint32_t perCluster() const { return clusters > 0 ? secondBounceVpls / clusters : 0; }
+};
+
+std::vector<ParamSpec> ssvpParamSpecs();
+/** Parses and cross-checks (throws gilab::Error naming the parameter). */
+SsvpSettings ssvpSettingsFrom(const ParamSet& params);
+
+}  // namespace gilab
