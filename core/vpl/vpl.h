@@ -1,8 +1,9 @@
 #pragma once
 /**
  * The shared VPL module (docs/vpl.md): virtual point lights and their clusters as the GPU stores
- * them. Mirrors Vpl / VplCluster in shaders/common/vpl.glsl (std430). Used by `ssvp` (Aranha et
- * al.) and meant for every VPL technique (topological VPLs, instant radiosity).
+ * them. Mirrors Vpl / VplCluster in shaders/common/vpl.glsl (std430). Used by the screen-space VPL
+ * propagation (Aranha et al.) and meant for every VPL technique (topological VPLs, instant
+ * radiosity).
  *
  * Units (docs/conventions.md): a VPL carries a flux [W]; it is a cosine emitter with intensity
  * I(w) = flux max(0, n.w) / pi [W/sr], so a receiver at distance d gets the irradiance

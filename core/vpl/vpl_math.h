@@ -69,8 +69,8 @@ inline float paraboloidSolidAngleDensity(const glm::vec2& p) {
 
 /**
  * Flux weight of a second-bounce VPL sampled uniformly on the unit disk of a cluster's map
- * (docs/techniques/ssvp.md "Weighting"): cosine emission of the cluster over the disk density,
- * 4 (1 - r^2) / (1 + r^2)^3 per sample of M; its mean over the disk is 1.
+ * (docs/vpl.md, "Weighting" of the technique docs): cosine emission of the cluster over the disk
+ * density, 4 (1 - r^2) / (1 + r^2)^3 per sample of M; its mean over the disk is 1.
  */
 inline float diskSampleWeight(const glm::vec2& p) {
     const float r2 = glm::dot(p, p);

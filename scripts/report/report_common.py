@@ -221,7 +221,8 @@ UPDATE_WORDS = {
                      "the light or camera moves, so its dynamic frame pays the whole set-up"),
     "none": ("b-update", "update: none needed",
              "nothing the technique precomputes depends on what moved (only the camera moved, "
-             "or the technique keeps no light of its own); the shared passes still updated"),
+             "the technique keeps no light of its own, or it redoes its lighting every frame, "
+             "like ssvp); the shared passes still updated"),
 }
 
 
