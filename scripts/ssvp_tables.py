@@ -93,25 +93,29 @@ def main(folder, gilab):
             rows.append(r)
     if not rows:
         sys.exit(f"{folder}: no finished ssvp runs")
-    rows.sort(key=lambda r: (r["scene"]["label"], r["technique"]["params"]["second_bounce_vpls"],
+    rows.sort(key=lambda r: (r["scene"]["label"], r["technique"]["params"]["bounces"],
+                             r["technique"]["params"]["second_bounce_vpls"],
                              r["technique"]["params"]["clusters"]))
     device = rows[0].get("device", {}).get("name", "?")
     print(f"Table I (median GPU ms per stage; device: {device})")
-    print("\t".join(["scene", "C", "N2"] + STAGES + ["total", "direct (not in Table I)"]))
+    print("\t".join(["scene", "C", "N2", "bounces"] + STAGES +
+                    ["total", "direct (not in Table I)"]))
     for r in rows:
         p = r["technique"]["params"]
         ms = stage_ms(r)
         total = sum(ms[k] for k in STAGES)
-        print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"])] +
-                        [fmt(ms[k]) for k in STAGES] + [fmt(total), fmt(ms["direct"])]))
-    print("\nError (final image) against the two-bounce reference and the full one")
-    print("\t".join(["scene", "C", "N2", "relMSE_2b", "HDR-FLIP_2b", "relMSE_full",
+        print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
+                          str(p["bounces"])] + [fmt(ms[k]) for k in STAGES] +
+                         [fmt(total), fmt(ms["direct"])]))
+    print("\nError (final image) against the claimed-bounce reference (2b: bounces = 2, else 1) "
+          "and the full one")
+    print("\t".join(["scene", "C", "N2", "bounces", "relMSE_2b", "HDR-FLIP_2b", "relMSE_full",
                      "HDR-FLIP_full", "energy_ratio", "clamped_%", "kmeans_it", "valid_vpls"]))
     for r in rows:
         p = r["technique"]["params"]
         s = r.get("stats", {})
         print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
-                         fmt(metric(r, "final", "rel_mse"), 4), fmt(metric(r, "final", "flip"), 4),
+                         str(p["bounces"]), fmt(metric(r, "final", "rel_mse"), 4), fmt(metric(r, "final", "flip"), 4),
                          fmt(metric(r, "final_vs_full", "rel_mse"), 4),
                          fmt(metric(r, "final_vs_full", "flip"), 4),
                          fmt(r.get("metrics", {}).get("energy_ratio"), 3),
