@@ -401,6 +401,8 @@ void expectParamError(const std::map<std::string, std::string>& values, const st
 TEST(CpuSsvpParams, CrossChecksNameTheParameter) {
     expectParamError({{"second_bounce_vpls", "100"}, {"clusters", "8"}}, "second_bounce_vpls");
     expectParamError({{"first_bounce_vpls", "4"}, {"clusters", "8"}}, "first_bounce_vpls");
+    expectParamError({{"clusters", "64"}, {"paraboloid_resolution", "2048"}},
+                     "paraboloid_resolution");
     const TechniqueInfo& info = TechniqueRegistry::instance().get("ssvp");
     EXPECT_EQ(info.bouncesParam, "bounces");
     EXPECT_EQ(claimedBounces(info, ssvpParams({{"bounces", "1"}})), 1);

@@ -4,6 +4,7 @@
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/pass_light.h"
+#include "core/scene/scene.h"
 #include "core/util/error.h"
 #include "core/vk/barrier.h"
 #include "core/vk/buffer.h"
@@ -35,6 +36,34 @@ vk::Image layer(vk::Context& ctx, uint32_t size, VkFormat format, VkImageUsageFl
 
 glm::vec3 row(const glm::mat4& m, int r) {
     return {m[0][r], m[1][r], m[2][r]};
+}
+
+/**
+ * A directional light's shadow view covers the scene's bounding sphere; its RSM is fitted to the
+ * rectangle the scene's bounding box projects to instead (x and y of the same view), so fewer
+ * texels, and fewer VPLs, fall on nothing. Depth and orientation stay the view's.
+ */
+glm::mat4 fitOrthoToBounds(const glm::mat4& viewProj, const Bounds& b) {
+    if (!b.valid()) return viewProj;
+    glm::vec2 lo(1e30f), hi(-1e30f);
+    for (int i = 0; i < 8; ++i) {
+        const glm::vec3 corner((i & 1) ? b.hi.x : b.lo.x, (i & 2) ? b.hi.y : b.lo.y,
+                               (i & 4) ? b.hi.z : b.lo.z);
+        const glm::vec4 c = viewProj * glm::vec4(corner, 1.0f);
+        lo = glm::min(lo, glm::vec2(c) / c.w);
+        hi = glm::max(hi, glm::vec2(c) / c.w);
+    }
+    lo = glm::max(lo, glm::vec2(-1.0f));
+    hi = glm::min(hi, glm::vec2(1.0f));
+    // Half a percent of margin so no surface sits on the border texels.
+    const glm::vec2 half = 0.505f * glm::max(hi - lo, glm::vec2(1e-6f));
+    const glm::vec2 centre = 0.5f * (lo + hi);
+    glm::mat4 remap(1.0f);
+    remap[0][0] = 1.0f / half.x;
+    remap[1][1] = 1.0f / half.y;
+    remap[3][0] = -centre.x / half.x;
+    remap[3][1] = -centre.y / half.y;
+    return remap * viewProj;
 }
 
 }  // namespace
@@ -92,11 +121,12 @@ void ReflectiveShadowMap::record(VkCommandBuffer cmd, const PassLight& entry, ui
         throw Error("reflective shadow map: pass light " + std::to_string(light) +
                     " is not a spot or directional light with a 2D view");
     const bool directional = uint32_t(entry.positionType.w) == kPassLightDirectional;
-    RsmPush push{entry.viewProj, directional ? glm::vec4(-glm::vec3(entry.direction), 1.0f)
-                                             : glm::vec4(glm::vec3(entry.positionType), 0.0f)};
+    const glm::mat4 vp = directional ? fitOrthoToBounds(entry.viewProj, m_scene.scene().caps.bounds)
+                                     : entry.viewProj;
+    RsmPush push{vp, directional ? glm::vec4(-glm::vec3(entry.direction), 1.0f)
+                                 : glm::vec4(glm::vec3(entry.positionType), 0.0f)};
     // Texel footprint (docs/vpl.md): the view maps a texel to 2 / (W |r0|) x 2 / (H |r1|) on the
     // plane at unit distance (perspective, scaled by |r3|^2) or in the world (orthographic).
-    const glm::mat4& vp = entry.viewProj;
     const float n = float(size());
     const float s = directional ? 1.0f : glm::length(row(vp, 3));
     const float area = 4.0f * s * s / (n * n * glm::length(row(vp, 0)) * glm::length(row(vp, 1)));

@@ -8,6 +8,7 @@ namespace gilab {
 namespace {
 
 constexpr ParamStage kRebuild = ParamStage::Rebuild;
+constexpr double kMaxMapMiB = 4096.0;  // as the shared shadow cubes (core/technique)
 
 }  // namespace
 
@@ -99,6 +100,15 @@ SsvpSettings ssvpSettingsFrom(const ParamSet& p) {
         throw Error("ssvp: first_bounce_vpls = " + std::to_string(s.firstBounceVpls) +
                     " is below clusters = " + std::to_string(s.clusters) +
                     ": K-means needs at least one VPL per cluster");
+    }
+    // The maps: position RGBA32F + normal, albedo RGBA16F + D32 per texel and layer.
+    const double mapMiB = double(s.clusters) * s.paraboloidResolution * s.paraboloidResolution *
+                          36.0 / (1024.0 * 1024.0);
+    if (mapMiB > kMaxMapMiB) {
+        throw Error("ssvp: clusters = " + std::to_string(s.clusters) +
+                    " x paraboloid_resolution = " + std::to_string(s.paraboloidResolution) +
+                    "^2 needs " + std::to_string(int(mapMiB)) + " MiB of paraboloid maps (limit " +
+                    std::to_string(int(kMaxMapMiB)) + " MiB); lower one of them");
     }
     return s;
 }
