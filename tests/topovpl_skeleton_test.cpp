@@ -11,6 +11,7 @@
 
 #include "core/voxel/distance_transform.h"
 #include "core/voxel/thinning.h"
+#include "techniques/topovpl/nearest_node.h"
 #include "techniques/topovpl/skeleton_graph.h"
 
 namespace gilab {
@@ -39,6 +40,7 @@ Rooms closedBox(uint32_t nx, uint32_t ny, uint32_t nz) {
 struct Topo {
     topo::SkeletonGraph graph;
     topo::Segmentation seg;
+    std::vector<uint32_t> labels;  // nearest-node grid
 };
 
 /** EDT of the walls -> maximal balls; curve skeleton of the empty space; segmentation. */
@@ -60,6 +62,10 @@ Topo segment(const Rooms& rooms, float alpha = 0.2f) {
     Topo t;
     t.graph = topo::buildSkeletonGraph(voxels, radii);
     t.seg = topo::segmentSkeleton(t.graph, alpha);
+    std::vector<uint8_t> open(rooms.solid.size());
+    for (size_t i = 0; i < open.size(); ++i)
+        open[i] = rooms.solid[i] ? 0 : 1;
+    t.labels = topo::nearestNodeGrid(open, rooms.dims, voxels, t.graph.voxelNode);
     std::printf(
         "%zu skeleton voxels, %zu nodes, %zu kept (%u topology, %u curvature, %u coverage), "
         "%u clusters, %zu gates\n",
@@ -107,6 +113,26 @@ TEST(CpuTopoSkeleton, TwoRoomsAreSeparatedByAGateAtTheDoor) {
         closest = std::min(closest, glm::length(g.centre - glm::vec3(19.5f, 7.5f, 7.5f)));
     }
     EXPECT_LT(closest, 3.0f);  // a gate in or just before the doorway
+
+    // The nearest-node grid never labels a voxel across the wall: deep inside each room (away
+    // from the door) every empty voxel maps to a node on its own side of the wall.
+    for (uint32_t z = 1; z < 15; ++z)
+        for (uint32_t y = 1; y < 15; ++y)
+            for (uint32_t x = 1; x < 39; ++x) {
+                const size_t i = r.dims.index(x, y, z);
+                if (r.solid[i]) {
+                    EXPECT_EQ(t.labels[i], topo::kNoNode);
+                    continue;
+                }
+                ASSERT_NE(t.labels[i], topo::kNoNode) << x << " " << y << " " << z;
+                const float nodeX = t.graph.position[t.labels[i]].x;
+                if (x < 14) {
+                    EXPECT_LT(nodeX, 19.0f) << x << " " << y << " " << z;
+                }
+                if (x > 25) {
+                    EXPECT_GT(nodeX, 20.0f) << x << " " << y << " " << z;
+                }
+            }
 }
 
 TEST(CpuTopoSkeleton, EveryNodeIsClusteredAndLinesMapToKeptNodes) {

@@ -1,0 +1,71 @@
+#include "techniques/topovpl/scene_topology.h"
+
+#include "core/scene/scene.h"
+#include "core/util/error.h"
+#include "core/voxel/distance_transform.h"
+#include "core/voxel/thinning.h"
+#include "core/voxel/voxelizer.h"
+#include "techniques/topovpl/nearest_node.h"
+
+namespace gilab::topo {
+
+SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene, const Scene& scene,
+                                 const TopologySettings& s, const StepTimer& time) {
+    if (!scene.caps.bounds.valid()) throw Error("topology: the scene has no geometry");
+    SceneTopology t;
+    t.grid = VoxelGrid(scene.caps.bounds, s.resolution);
+    const uint32_t n = s.resolution;
+    t.dims = {n, n, n};
+    std::vector<uint8_t> solid(t.dims.count(), 0);
+    time("voxelization", [&] {
+        Voxelizer voxelizer(ctx, gpuScene, t.grid);
+        voxelizer.run();
+        const VoxelData data = voxelizer.readVoxels();
+        for (size_t i = 0; i < solid.size(); ++i)
+            solid[i] = data.count[i] > 0 ? 1 : 0;
+        for (uint32_t z = 0; z < n; ++z)  // close the empty space with the grid's border
+            for (uint32_t y = 0; y < n; ++y)
+                for (uint32_t x = 0; x < n; ++x)
+                    if (x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1)
+                        solid[t.dims.index(x, y, z)] = 1;
+    });
+    std::vector<float> radius;
+    time("distance_transform", [&] { radius = distanceTransform(solid, t.dims); });
+    std::vector<uint8_t> empty(solid.size());
+    for (size_t i = 0; i < empty.size(); ++i) {
+        empty[i] = solid[i] ? 0 : 1;
+        t.emptyVoxels += empty[i];
+    }
+    t.solidVoxels = uint32_t(solid.size()) - t.emptyVoxels;
+    std::vector<uint8_t> skeleton = empty;
+    time("thinning", [&] { thinCurveSkeleton(skeleton, t.dims); });
+    std::vector<glm::ivec3> voxels;
+    std::vector<float> radii;
+    for (uint32_t z = 0; z < n; ++z)
+        for (uint32_t y = 0; y < n; ++y)
+            for (uint32_t x = 0; x < n; ++x)
+                if (skeleton[t.dims.index(x, y, z)]) {
+                    voxels.emplace_back(x, y, z);
+                    radii.push_back(radius[t.dims.index(x, y, z)]);
+                }
+    t.skeletonVoxels = uint32_t(voxels.size());
+    time("segmentation", [&] {
+        t.graph = buildSkeletonGraph(voxels, radii);
+        t.segmentation = segmentSkeleton(t.graph, s.alpha);
+    });
+    time("nearest_node", [&] {
+        const std::vector<uint32_t> labels =
+            nearestNodeGrid(empty, t.dims, voxels, t.graph.voxelNode);
+        t.voxelCluster.assign(labels.size(), kNoNode);
+        for (size_t i = 0; i < labels.size(); ++i)
+            if (labels[i] != kNoNode) t.voxelCluster[i] = t.segmentation.cluster[labels[i]];
+    });
+    // Gates in world units: voxel coordinates are voxel corners; centres are at + 0.5.
+    const float v = t.grid.voxelSize();
+    for (const Gate& g : t.segmentation.gates)
+        t.gates.push_back(
+            {t.grid.gridToWorld(g.centre + 0.5f), g.normal, g.radius * v, g.clusterA, g.clusterB});
+    return t;
+}
+
+}  // namespace gilab::topo
