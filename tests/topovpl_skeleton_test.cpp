@@ -79,6 +79,37 @@ Topo segment(const Rooms& rooms, float alpha = 0.2f) {
     return t;
 }
 
+// A line with two side branches at its middle: the short one lies inside the junction's maximal
+// ball and is pruned (its voxels map to the junction); the long one is kept.
+TEST(CpuTopoSkeleton, CoveredSpursArePruned) {
+    std::vector<glm::ivec3> voxels;
+    std::vector<float> radii;
+    for (int x = 0; x <= 20; ++x) {
+        voxels.emplace_back(x, 0, 0);
+        radii.push_back(x == 10 ? 4.0f : 2.0f);
+    }
+    for (int y = 1; y <= 3; ++y) {  // short branch: tip 3 from the junction, radius 4
+        voxels.emplace_back(10, y, 0);
+        radii.push_back(1.0f);
+    }
+    for (int z = 1; z <= 9; ++z) {  // long branch: tip 9 away
+        voxels.emplace_back(10, 0, z);
+        radii.push_back(1.0f);
+    }
+    const topo::SkeletonGraph pruned = topo::buildSkeletonGraph(voxels, radii);
+    const topo::SkeletonGraph full = topo::buildSkeletonGraph(voxels, radii, false);
+    EXPECT_EQ(full.prunedNodes, 0u);
+    EXPECT_GE(pruned.prunedNodes, 2u);
+    EXPECT_EQ(pruned.position.size() + pruned.prunedNodes, full.position.size());
+    // The long branch's tip survives as a degree-1 node; the short branch's voxels map to the
+    // junction's node.
+    const uint32_t junction = pruned.voxelNode[10];
+    EXPECT_EQ(pruned.voxelNode[21 + 2], junction);  // (10, 3, 0), the short tip
+    const uint32_t longTip = pruned.voxelNode[voxels.size() - 1];
+    EXPECT_EQ(pruned.adjacency[longTip].size(), 1u);
+    EXPECT_EQ(glm::ivec3(pruned.position[longTip]), glm::ivec3(10, 0, 9));
+}
+
 TEST(CpuTopoSkeleton, ClosedBoxIsOneCluster) {
     for (glm::uvec3 size : {glm::uvec3(24, 16, 20), glm::uvec3(30, 12, 12), glm::uvec3(16)}) {
         const Topo t = segment(closedBox(size.x, size.y, size.z));

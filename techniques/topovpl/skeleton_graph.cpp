@@ -176,10 +176,78 @@ void clusterNodes(const SkeletonGraph& g, Segmentation& s, float alpha) {
     }
 }
 
+/** Removes end branches covered by their junction's ball (see the header), then reindexes. */
+void pruneCoveredSpurs(SkeletonGraph& g) {
+    const uint32_t n = uint32_t(g.position.size());
+    std::vector<uint8_t> removed(n, 0);
+    std::vector<uint32_t> mergedInto(n);
+    std::iota(mergedInto.begin(), mergedInto.end(), 0u);
+    auto degree = [&](uint32_t i) {
+        uint32_t d = 0;
+        for (uint32_t w : g.adjacency[i])
+            d += removed[w] ? 0 : 1;
+        return d;
+    };
+    for (bool changed = true; changed;) {
+        changed = false;
+        for (uint32_t tip = 0; tip < n; ++tip) {
+            if (removed[tip] || degree(tip) != 1) continue;
+            // Walk from the tip to the first node of degree >= 3.
+            std::vector<uint32_t> branch{tip};
+            uint32_t prev = tip, cur = tip;
+            for (;;) {
+                uint32_t next = prev;
+                for (uint32_t w : g.adjacency[cur])
+                    if (!removed[w] && w != prev && (cur == tip || w != branch.front())) {
+                        next = w;
+                        break;
+                    }
+                if (next == prev || next == cur) break;
+                prev = cur;
+                cur = next;
+                if (degree(cur) != 2) break;
+                branch.push_back(cur);
+            }
+            if (degree(cur) < 3) continue;  // an isolated line: nothing to prune against
+            if (glm::length(g.position[tip] - g.position[cur]) > g.maxball[cur]) continue;
+            for (uint32_t b : branch) {
+                removed[b] = 1;
+                mergedInto[b] = cur;
+            }
+            changed = true;
+        }
+    }
+    // Reindex the kept nodes; removed ones follow their junction.
+    std::vector<uint32_t> newIndex(n, 0);
+    uint32_t kept = 0;
+    for (uint32_t i = 0; i < n; ++i)
+        if (!removed[i]) newIndex[i] = kept++;
+    auto finalNode = [&](uint32_t i) {
+        while (removed[i])
+            i = mergedInto[i];
+        return newIndex[i];
+    };
+    SkeletonGraph out;
+    out.prunedNodes = n - kept;
+    for (uint32_t i = 0; i < n; ++i) {
+        if (removed[i]) continue;
+        out.position.push_back(g.position[i]);
+        out.maxball.push_back(g.maxball[i]);
+        std::vector<uint32_t> adj;
+        for (uint32_t w : g.adjacency[i])
+            if (!removed[w]) adj.push_back(newIndex[w]);
+        out.adjacency.push_back(std::move(adj));
+    }
+    out.voxelNode.resize(g.voxelNode.size());
+    for (size_t v = 0; v < g.voxelNode.size(); ++v)
+        out.voxelNode[v] = finalNode(g.voxelNode[v]);
+    g = std::move(out);
+}
+
 }  // namespace
 
 SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
-                                 const std::vector<float>& maxball) {
+                                 const std::vector<float>& maxball, bool pruneSpurs) {
     if (voxels.size() != maxball.size())
         throw Error("skeleton graph: " + std::to_string(voxels.size()) + " voxels but " +
                     std::to_string(maxball.size()) + " radii");
@@ -232,6 +300,7 @@ SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
             addEdge(g.adjacency, g.voxelNode[i], g.voxelNode[w]);
     for (auto& a : g.adjacency)
         std::sort(a.begin(), a.end());
+    if (pruneSpurs) pruneCoveredSpurs(g);
     return g;
 }
 

@@ -37,11 +37,18 @@ struct SkeletonGraph {
     std::vector<float> maxball;       // maximal-ball radius in voxels
     std::vector<std::vector<uint32_t>> adjacency;
     std::vector<uint32_t> voxelNode;  // per skeleton voxel (input order): its node
+    uint32_t prunedNodes = 0;         // nodes removed with covered spurs
 };
 
-/** Builds the graph from skeleton voxels (x, y, z) and their maximal-ball radii. */
+/**
+ * Builds the graph from skeleton voxels (x, y, z) and their maximal-ball radii. With
+ * `pruneCoveredSpurs`, end branches whose tip lies inside the maximal ball of the junction they
+ * leave from are removed, repeatedly (their voxels map to that junction): branches that carry no
+ * shape the junction's ball does not already hold. It stands in for the lifespan (persistence)
+ * filter of the paper's thinning (Chaussard et al. 2013), which our thinning does not have.
+ */
 SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
-                                 const std::vector<float>& maxball);
+                                 const std::vector<float>& maxball, bool pruneCoveredSpurs = true);
 
 struct Gate {
     glm::vec3 centre{0.0f};
