@@ -6,6 +6,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/scene/procedural_cornell.h"
+#include "core/scene/procedural_rooms.h"
 #include "core/scene/scene_loader.h"
 #include "core/util/error.h"
 
@@ -102,6 +104,36 @@ bool isClosed(const Scene& s, int material) {
         if (item.second != 2) return false;
     }
     return true;
+}
+
+/** The nearest hit of the ray origin + t dir, t in (1e-7, tMax): its triangle (-1: none) and t. */
+struct RayHit {
+    int triangle = -1;
+    double t = 0.0;
+};
+
+RayHit firstHit(const Scene& s, const glm::vec3& origin, const glm::vec3& dir, double tMax) {
+    RayHit hit;
+    hit.t = tMax;
+    const glm::dvec3 o(origin), d(dir);
+    for (size_t t = 0; t < s.triangleCount(); ++t) {
+        // Moller-Trumbore, in double precision
+        const glm::dvec3 a(s.vertices[s.indices[3 * t]].position);
+        const glm::dvec3 e1 = glm::dvec3(s.vertices[s.indices[3 * t + 1]].position) - a;
+        const glm::dvec3 e2 = glm::dvec3(s.vertices[s.indices[3 * t + 2]].position) - a;
+        const glm::dvec3 p = glm::cross(d, e2);
+        const double det = glm::dot(e1, p);
+        if (std::abs(det) < 1e-15) continue;
+        const glm::dvec3 q = o - a;
+        const double u = glm::dot(q, p) / det;
+        const glm::dvec3 r = glm::cross(q, e1);
+        const double v = glm::dot(d, r) / det;
+        const double dist = glm::dot(e2, r) / det;
+        if (u < 0.0 || v < 0.0 || u + v > 1.0 || dist <= 1e-7 || dist >= hit.t) continue;
+        hit.triangle = int(t);
+        hit.t = dist;
+    }
+    return hit;
 }
 
 /** This file's temporary folders (tests/temp_dir.h). */
@@ -447,6 +479,104 @@ TEST(CpuCornellBox, AlbedoScaleClampsAndRejectsNegative) {
 }
 
 // ---------------------------------------------------------------------------------------------
+// Procedural two rooms joined by a door
+// ---------------------------------------------------------------------------------------------
+
+std::string hitMaterial(const Scene& s, const RayHit& hit) {
+    return hit.triangle < 0 ? "(nothing)"
+                            : s.materials[s.triangleMaterials[size_t(hit.triangle)]].name;
+}
+
+TEST(CpuTwoRooms, DefaultGeometryAndCaps) {
+    const Scene s = makeTwoRooms({});
+    EXPECT_EQ(s.name, "two_rooms");
+    // Shell 6 quads; slab 5 wall cells x 2 faces + 12 rim quads (the door reaches the floor)
+    EXPECT_EQ(s.triangleCount(), 2u * (6u + 10u + 12u));
+    EXPECT_EQ(s.materials.size(), 7u);
+    EXPECT_FALSE(s.caps.hasEmissive);
+    EXPECT_TRUE(s.lights.empty());
+    EXPECT_NEAR(s.caps.bounds.lo.x, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.lo.y, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.lo.z, 0.0f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.hi.x, 1.02f, 1e-6f);  // two 0.5 m rooms and the 2 cm wall
+    EXPECT_NEAR(s.caps.bounds.hi.y, 0.5f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.hi.z, 0.5f, 1e-6f);
+    const int red = materialIndex(s, "farWallA");
+    ASSERT_GE(red, 0);
+    EXPECT_EQ(glm::vec3(s.materials[size_t(red)].baseColorFactor), glm::vec3(0.63f, 0.065f, 0.05f));
+    EXPECT_EQ(glm::vec3(s.materials[size_t(materialIndex(s, "divider"))].baseColorFactor),
+              glm::vec3(0.7f));
+    for (const Material& m : s.materials) {
+        EXPECT_EQ(m.metallic, 0.0f) << m.name;
+        EXPECT_EQ(m.roughness, 1.0f) << m.name;
+    }
+    // The camera is in room B, looking at the divider (towards -x)
+    const TwoRoomsLayout layout = twoRoomsLayout({});
+    EXPECT_GT(s.camera.position.x, layout.roomB.lo.x);
+    EXPECT_LT(s.camera.position.x, layout.roomB.hi.x);
+    EXPECT_LT(s.camera.target.x, s.camera.position.x);
+}
+
+TEST(CpuTwoRooms, NormalsFaceIntoTheRoomsAndTheSlabIsClosed) {
+    for (const glm::vec4& door :
+         {glm::vec4(0.35f, 0.0f, 0.65f, 0.6f), glm::vec4(0.2f, 0.1f, 0.5f, 0.7f)}) {
+        for (bool open : {true, false}) {
+            TwoRoomsParams p;
+            p.door = door;
+            p.doorOpen = open;
+            const Scene s = makeTwoRooms(p);
+            const int divider = materialIndex(s, "divider");
+            EXPECT_TRUE(isClosed(s, divider)) << "door " << open;
+            const glm::vec3 centre = s.caps.bounds.center();
+            for (size_t t = 0; t < s.triangleCount(); ++t) {
+                const glm::vec3 g = geometricNormal(s, t);
+                for (int k = 0; k < 3; ++k)
+                    EXPECT_GT(glm::dot(s.vertices[s.indices[3 * t + size_t(k)]].normal, g), 0.999f);
+                if (int(s.triangleMaterials[t]) == divider) continue;
+                EXPECT_GT(glm::dot(g, centre - triangleCentre(s, t)), 0.0f)
+                    << s.materials[s.triangleMaterials[t]].name << " faces out";
+            }
+        }
+    }
+    TwoRoomsParams closed;
+    closed.doorOpen = false;
+    EXPECT_EQ(makeTwoRooms(closed).triangleCount(), 2u * (6u + 2u + 4u));
+}
+
+TEST(CpuTwoRooms, DoorAreaAndBadParameters) {
+    TwoRoomsParams p;
+    p.roomSize = {0.4f, 0.3f, 0.6f};
+    const Scene s = makeTwoRooms(p);
+    const int divider = materialIndex(s, "divider");
+    float area = 0.0f;
+    for (size_t t = 0; t < s.triangleCount(); ++t)
+        if (int(s.triangleMaterials[t]) == divider) area += triangleArea(s, t);
+    // Each face: the 0.6 x 0.3 wall less the 0.18 x 0.18 door. The 2 cm rims: the wall's outline
+    // less the door's sill (the floor closes it), plus two 0.18 jambs and the 0.18 lintel.
+    const float face = 0.6f * 0.3f - 0.18f * 0.18f;
+    const float rims = 0.02f * ((2.0f * 0.6f + 2.0f * 0.3f - 0.18f) + 3.0f * 0.18f);
+    EXPECT_NEAR(area, 2.0f * face + rims, 1e-5f);
+    const TwoRoomsLayout layout = twoRoomsLayout(p);
+    EXPECT_NEAR(layout.door.lo.z, 0.21f, 1e-6f);
+    EXPECT_NEAR(layout.door.hi.z, 0.39f, 1e-6f);
+    EXPECT_NEAR(layout.door.hi.y, 0.18f, 1e-6f);
+    EXPECT_NEAR(layout.roomB.hi.x, 0.82f, 1e-6f);
+
+    TwoRoomsParams bad;
+    bad.wallThickness = 0.0f;
+    expectError([&] { makeTwoRooms(bad); }, {"two_rooms", "wall_thickness"});
+    bad = {};
+    bad.roomSize.y = -1.0f;
+    expectError([&] { makeTwoRooms(bad); }, {"two_rooms", "room_size"});
+    bad = {};
+    bad.door = {0.5f, 0.0f, 0.4f, 0.6f};
+    expectError([&] { makeTwoRooms(bad); }, {"two_rooms", "door"});
+    bad = {};
+    bad.red = glm::vec3(1.5f, 0.0f, 0.0f);
+    expectError([&] { makeTwoRooms(bad); }, {"two_rooms", "red"});
+}
+
+// ---------------------------------------------------------------------------------------------
 // Camera: the rasteriser (view/projection) and the path tracer (primaryRay) agree
 // ---------------------------------------------------------------------------------------------
 
@@ -626,6 +756,83 @@ TEST(CpuSceneFile, DefaultCameraFramesTheBounds) {
     EXPECT_LT(glm::length(s.camera.target - glm::vec3(0.5f, 0.5f, 0.0f)), 1e-5f);
 }
 
+const std::string kTwoRooms = kScenes + "/stress/two_rooms_door.json";
+
+TEST(CpuSceneFile, TwoRoomsDoorLoads) {
+    const Scene s = loadSceneFile(kTwoRooms);
+    EXPECT_EQ(s.name, "two_rooms_door");
+    EXPECT_EQ(s.triangleCount(), makeTwoRooms({}).triangleCount());
+    EXPECT_NEAR(s.caps.bounds.hi.x - s.caps.bounds.lo.x, 1.02f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.hi.y - s.caps.bounds.lo.y, 0.5f, 1e-6f);
+    EXPECT_NEAR(s.caps.bounds.hi.z - s.caps.bounds.lo.z, 0.5f, 1e-6f);
+    EXPECT_EQ(s.settings.width, 64);
+    EXPECT_EQ(s.settings.height, 64);
+    ASSERT_EQ(s.lights.size(), 1u);
+    EXPECT_EQ(s.lights[0].type, LightType::Spot);
+    const TwoRoomsLayout layout = twoRoomsLayout({});
+    auto inside = [](const Bounds& b, const glm::vec3& p) {
+        return glm::all(glm::greaterThan(p, b.lo)) && glm::all(glm::lessThan(p, b.hi));
+    };
+    EXPECT_TRUE(inside(layout.roomA, s.lights[0].position));
+    EXPECT_TRUE(inside(layout.roomB, s.camera.position));
+    const Scene closed = loadSceneFile(kTwoRooms + "#closed");
+    EXPECT_EQ(closed.name, "two_rooms_door#closed");
+    EXPECT_LT(closed.triangleCount(), s.triangleCount());
+}
+
+/** Room B is lit only through the door: the spot's cone misses the whole opening. */
+TEST(CpuSceneFile, TwoRoomsDoorSpotMissesTheDoor) {
+    const Scene s = loadSceneFile(kTwoRooms);
+    const Light& l = s.lights.at(0);
+    const Bounds door = twoRoomsLayout({}).door;
+    float minAngle = glm::pi<float>();
+    const int n = 64;
+    for (int i = 0; i <= n; ++i) {
+        for (int j = 0; j <= n; ++j) {
+            for (float x : {door.lo.x, door.hi.x}) {
+                const glm::vec3 p(x, door.lo.y + door.extent().y * float(j) / n,
+                                  door.lo.z + door.extent().z * float(i) / n);
+                const float c = glm::dot(glm::normalize(p - l.position), l.direction);
+                minAngle = std::min(minAngle, std::acos(std::clamp(c, -1.0f, 1.0f)));
+            }
+        }
+    }
+    EXPECT_GT(minAngle, l.outerConeRad + glm::radians(2.0f));
+    // ...and it does light room A's floor next to the door
+    const RayHit axis = firstHit(s, l.position, l.direction, 10.0);
+    ASSERT_GE(axis.triangle, 0);
+    EXPECT_EQ(hitMaterial(s, axis), "floor");
+    const glm::vec3 spotOnFloor = l.position + float(axis.t) * l.direction;
+    EXPECT_LT(door.lo.x - spotOnFloor.x, 0.25f);
+}
+
+/** A ray from room A through the door reaches room B; with the door closed the slab stops it. */
+TEST(CpuSceneFile, TwoRoomsDoorLeavesAnOpening) {
+    const TwoRoomsLayout layout = twoRoomsLayout({});
+    const glm::vec3 doorCentre = layout.door.center();
+    const Scene open = loadSceneFile(kTwoRooms);
+    const Scene closed = loadSceneFile(kTwoRooms + "#closed");
+
+    // Level with the door's centre: straight across to room B's far wall
+    const glm::vec3 start(layout.roomA.center().x, doorCentre.y, doorCentre.z);
+    const glm::vec3 across(1.0f, 0.0f, 0.0f);
+    const RayHit a = firstHit(open, start, across, 10.0);
+    EXPECT_EQ(hitMaterial(open, a), "farWallB");
+    EXPECT_NEAR(start.x + float(a.t), layout.roomB.hi.x, 1e-5f);
+    const RayHit b = firstHit(closed, start, across, 10.0);
+    EXPECT_EQ(hitMaterial(closed, b), "divider");
+    EXPECT_NEAR(start.x + float(b.t), layout.door.lo.x, 1e-5f);  // room A's face of the slab
+
+    // From room A's centre through the door's centre: the first hit is inside room B
+    const glm::vec3 centre = layout.roomA.center();
+    const glm::vec3 dir = glm::normalize(doorCentre - centre);
+    const RayHit c = firstHit(open, centre, dir, 10.0);
+    ASSERT_GE(c.triangle, 0);
+    EXPECT_GT((centre + float(c.t) * dir).x, layout.roomB.lo.x) << hitMaterial(open, c);
+    const RayHit d = firstHit(closed, centre, dir, 10.0);
+    EXPECT_EQ(hitMaterial(closed, d), "divider");
+}
+
 // ---------------------------------------------------------------------------------------------
 // glTF features on tiny hand-built files
 // ---------------------------------------------------------------------------------------------
@@ -771,6 +978,34 @@ TEST(CpuSceneErrors, UnknownKeysAndBadValues) {
 TEST(CpuSceneErrors, UnknownVariantListsTheAvailableOnes) {
     expectError([] { loadSceneFile(kScenes + "/cornell_box.json#nope"); },
                 {"cornell_box.json", "unknown variant \"nope\"", "point, spot"});
+}
+
+TEST(CpuSceneErrors, TwoRoomsBadParametersNameTheKey) {
+    TempDir dir;
+    auto check = [&](const std::string& name, const std::string& procedural,
+                     std::initializer_list<std::string> fragments) {
+        const std::string path =
+            dir.write(name, R"({"procedural": {"generator": "two_rooms", )" + procedural + "}}");
+        SCOPED_TRACE(name);
+        expectError([&] { loadSceneFile(path); }, fragments);
+    };
+    check("size.json", R"("room_size": [0.5, -0.5, 0.5])",
+          {"size.json", "procedural.room_size[1]", "out of range"});
+    check("size3.json", R"("room_size": [0.5, 0.5])", {"size3.json", "procedural.room_size"});
+    check("thick.json", R"("wall_thickness": -0.01)",
+          {"thick.json", "procedural.wall_thickness", "out of range"});
+    check("thin.json", R"("wall_thickness": 0)", {"thin.json", "procedural.wall_thickness"});
+    check("order.json", R"("door": [0.6, 0.0, 0.4, 0.5])",
+          {"order.json", "procedural.door", "z0 < z1"});
+    check("outside.json", R"("door": [0.2, 0.0, 1.2, 0.5])",
+          {"outside.json", "procedural.door[2]", "out of range"});
+    check("short.json", R"("door": [0.2, 0.0, 0.5])", {"short.json", "procedural.door"});
+    check("flag.json", R"("door_open": "no")", {"flag.json", "procedural.door_open"});
+    check("red.json", R"("red": [1.5, 0, 0])", {"red.json", "procedural.red"});
+    check("key.json", R"("doors": [0.2, 0.0, 0.5, 0.5])", {"key.json", "procedural.doors"});
+    const std::string path = dir.write("gen.json", R"({"procedural": {"generator": "two_room"}})");
+    expectError([&] { loadSceneFile(path); },
+                {"gen.json", "unknown generator \"two_room\"", "cornell_box, two_rooms"});
 }
 
 TEST(CpuSceneErrors, NanVertex) {

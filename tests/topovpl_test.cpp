@@ -6,13 +6,17 @@
 
 #include <gtest/gtest.h>
 
+#include <tiny_gltf.h>
+
 #include "tests/gpu_test_fixture.h"
+#include "tests/temp_dir.h"
 
 #include "core/gpu/gpu_scene.h"
 #include "core/scene/procedural_cornell.h"
 #include "core/scene/scene.h"
 #include "techniques/topovpl/nearest_node.h"
 #include "techniques/topovpl/scene_topology.h"
+#include "techniques/topovpl/topology_export.h"
 
 namespace gilab {
 namespace {
@@ -59,6 +63,33 @@ TEST_F(GpuTopology, CornellBoxTopologyLabelsTheEmptySpace) {
         EXPECT_GT(g.radius, 0.0f);
         EXPECT_NEAR(glm::length(g.normal), 1.0f, 1e-4f);
     }
+
+    // The debug export is a glTF file a viewer (here tinygltf) loads back: the skeleton's edges
+    // as lines, the kept nodes as points, every gate as a 24-triangle disk.
+    test::TempDir dir("gilab_topology");
+    const std::string file = dir.path("cornell_topology.gltf");
+    topo::exportTopologyGltf(t, file);
+    tinygltf::Model model;
+    tinygltf::TinyGLTF loader;
+    std::string err, warn;
+    ASSERT_TRUE(loader.LoadASCIIFromFile(&model, &err, &warn, file)) << err;
+    size_t edges = 0;
+    for (uint32_t a : t.segmentation.kept)
+        for (uint32_t b : t.segmentation.segmentedAdjacency[a])
+            edges += b > a;
+    for (const tinygltf::Mesh& m : model.meshes) {
+        const tinygltf::Primitive& p = m.primitives.at(0);
+        const size_t vertices = model.accessors.at(size_t(p.attributes.at("POSITION"))).count;
+        if (m.name == "skeleton") {
+            EXPECT_EQ(p.mode, TINYGLTF_MODE_LINE);
+            EXPECT_EQ(model.accessors.at(size_t(p.indices)).count, 2 * edges);
+        } else if (m.name == "nodes") {
+            EXPECT_EQ(vertices, t.segmentation.kept.size());
+        } else if (m.name == "gates") {
+            EXPECT_EQ(model.accessors.at(size_t(p.indices)).count, 72 * t.gates.size());
+        }
+    }
+    EXPECT_EQ(model.meshes.size(), t.gates.empty() ? 2u : 3u);
 }
 
 }  // namespace

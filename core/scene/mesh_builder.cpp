@@ -150,4 +150,56 @@ void appendQuad(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm:
     scene.triangleMaterials.insert(scene.triangleMaterials.end(), 2, material);
 }
 
+void appendWall(Scene& scene, const glm::vec3& origin, const glm::vec3& u, const glm::vec3& v,
+                const glm::vec3& inward, float thickness, const std::optional<glm::vec4>& hole,
+                uint32_t material) {
+    std::vector<float> us = {0.0f, 1.0f}, vs = {0.0f, 1.0f};
+    if (hole) {
+        us = {0.0f, hole->x, hole->z, 1.0f};
+        vs = {0.0f, hole->y, hole->w, 1.0f};
+        us.erase(std::unique(us.begin(), us.end()), us.end());
+        vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
+    }
+    const int nu = int(us.size()) - 1, nv = int(vs.size()) - 1;
+    auto solid = [&](int i, int j) {
+        if (i < 0 || j < 0 || i >= nu || j >= nv) return false;
+        if (!hole) return true;
+        const float cu = 0.5f * (us[size_t(i)] + us[size_t(i) + 1]);
+        const float cv = 0.5f * (vs[size_t(j)] + vs[size_t(j) + 1]);
+        return !(cu > hole->x && cu < hole->z && cv > hole->y && cv < hole->w);
+    };
+    const glm::vec3 out = -thickness * inward;
+    auto at = [&](float a, float b) { return origin + a * u + b * v; };
+    for (int i = 0; i < nu; ++i) {
+        for (int j = 0; j < nv; ++j) {
+            if (!solid(i, j)) continue;
+            const float a0 = us[size_t(i)], a1 = us[size_t(i) + 1];
+            const float b0 = vs[size_t(j)], b1 = vs[size_t(j) + 1];
+            const glm::vec3 p00 = at(a0, b0), p10 = at(a1, b0), p11 = at(a1, b1), p01 = at(a0, b1);
+            appendQuad(scene, p00, p10, p11, p01, inward, material);
+            if (thickness <= 0.0f) continue;
+            appendQuad(scene, p00 + out, p10 + out, p11 + out, p01 + out, -inward, material);
+            // Side faces where the neighbouring cell is empty (outside or the hole)
+            auto side = [&](const glm::vec3& p, const glm::vec3& q, const glm::vec3& facing) {
+                appendQuad(scene, p, q, q + out, p + out, facing, material);
+            };
+            if (!solid(i - 1, j)) side(p00, p01, -u);
+            if (!solid(i + 1, j)) side(p10, p11, u);
+            if (!solid(i, j - 1)) side(p00, p10, -v);
+            if (!solid(i, j + 1)) side(p01, p11, v);
+        }
+    }
+}
+
+uint32_t appendLambertianMaterial(Scene& scene, const std::string& name, const glm::vec3& albedo) {
+    Material mat;
+    mat.name = name;
+    mat.baseColorFactor = glm::vec4(albedo, 1.0f);
+    mat.metallic = 0.0f;
+    mat.roughness = 1.0f;
+    mat.doubleSided = true;
+    scene.materials.push_back(mat);
+    return uint32_t(scene.materials.size() - 1);
+}
+
 }  // namespace gilab

@@ -5,6 +5,7 @@
  */
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -42,5 +43,19 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
  */
 void appendQuad(Scene& scene, const glm::vec3& a, const glm::vec3& b, const glm::vec3& c,
                 const glm::vec3& d, const glm::vec3& facing, uint32_t material);
+
+/**
+ * One wall of a room: the interior rectangle origin + [0,1]^2 (u, v) facing `inward`, extruded
+ * outwards (against `inward`) by `thickness` into a closed slab when thickness > 0. An optional
+ * hole [u0, v0, u1, v1] (fractions of u and v) splits the wall into grid cells; every boundary
+ * edge of the solid cells gets a side face, so the slab stays closed (each edge shared by exactly
+ * two triangles).
+ */
+void appendWall(Scene& scene, const glm::vec3& origin, const glm::vec3& u, const glm::vec3& v,
+                const glm::vec3& inward, float thickness, const std::optional<glm::vec4>& hole,
+                uint32_t material);
+
+/** Appends a double-sided Lambertian material (metallic 0, roughness 1); returns its index. */
+uint32_t appendLambertianMaterial(Scene& scene, const std::string& name, const glm::vec3& albedo);
 
 }  // namespace gilab

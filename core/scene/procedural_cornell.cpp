@@ -1,8 +1,7 @@
 #include "core/scene/procedural_cornell.h"
 
-#include <algorithm>
 #include <cmath>
-#include <vector>
+#include <string>
 
 #include "core/scene/mesh_builder.h"
 #include "core/util/error.h"
@@ -29,64 +28,6 @@ constexpr glm::vec2 kLightHi{343.0f, 332.0f};
 
 [[noreturn]] void invalid(const std::string& message) {
     throw Error("cornell_box: " + message);
-}
-
-uint32_t addMaterial(Scene& scene, const std::string& name, const glm::vec3& albedo) {
-    Material mat;
-    mat.name = name;
-    mat.baseColorFactor = glm::vec4(albedo, 1.0f);
-    mat.metallic = 0.0f;
-    mat.roughness = 1.0f;
-    mat.doubleSided = true;
-    scene.materials.push_back(mat);
-    return uint32_t(scene.materials.size() - 1);
-}
-
-/**
- * One wall: the interior rectangle origin + [0,1]^2 (U, V) facing `inward`, extruded outwards
- * by `thickness` into a closed slab when thickness > 0. An optional hole [u0,v0,u1,v1] splits
- * the wall into grid cells; every boundary edge of the solid cells gets a side face, so the
- * slab stays closed (each edge shared by exactly two triangles).
- */
-void addWall(Scene& scene, const glm::vec3& origin, const glm::vec3& u, const glm::vec3& v,
-             const glm::vec3& inward, float thickness, const std::optional<glm::vec4>& hole,
-             uint32_t material) {
-    std::vector<float> us = {0.0f, 1.0f}, vs = {0.0f, 1.0f};
-    if (hole) {
-        us = {0.0f, hole->x, hole->z, 1.0f};
-        vs = {0.0f, hole->y, hole->w, 1.0f};
-        us.erase(std::unique(us.begin(), us.end()), us.end());
-        vs.erase(std::unique(vs.begin(), vs.end()), vs.end());
-    }
-    const int nu = int(us.size()) - 1, nv = int(vs.size()) - 1;
-    auto solid = [&](int i, int j) {
-        if (i < 0 || j < 0 || i >= nu || j >= nv) return false;
-        if (!hole) return true;
-        const float cu = 0.5f * (us[size_t(i)] + us[size_t(i) + 1]);
-        const float cv = 0.5f * (vs[size_t(j)] + vs[size_t(j) + 1]);
-        return !(cu > hole->x && cu < hole->z && cv > hole->y && cv < hole->w);
-    };
-    const glm::vec3 out = -thickness * inward;
-    auto at = [&](float a, float b) { return origin + a * u + b * v; };
-    for (int i = 0; i < nu; ++i) {
-        for (int j = 0; j < nv; ++j) {
-            if (!solid(i, j)) continue;
-            const float a0 = us[size_t(i)], a1 = us[size_t(i) + 1];
-            const float b0 = vs[size_t(j)], b1 = vs[size_t(j) + 1];
-            const glm::vec3 p00 = at(a0, b0), p10 = at(a1, b0), p11 = at(a1, b1), p01 = at(a0, b1);
-            appendQuad(scene, p00, p10, p11, p01, inward, material);
-            if (thickness <= 0.0f) continue;
-            appendQuad(scene, p00 + out, p10 + out, p11 + out, p01 + out, -inward, material);
-            // Side faces where the neighbouring cell is empty (outside or the hole)
-            auto side = [&](const glm::vec3& p, const glm::vec3& q, const glm::vec3& facing) {
-                appendQuad(scene, p, q, q + out, p + out, facing, material);
-            };
-            if (!solid(i - 1, j)) side(p00, p01, -u);
-            if (!solid(i + 1, j)) side(p10, p11, u);
-            if (!solid(i, j - 1)) side(p00, p10, -v);
-            if (!solid(i, j + 1)) side(p01, p11, v);
-        }
-    }
 }
 
 /** A block: the measured top quad plus four sides down to the floor, facing outwards. */
@@ -157,28 +98,28 @@ Scene makeCornellBox(const CornellBoxParams& p) {
     const std::optional<glm::vec4> noHole;
 
     // Walls: floor and ceiling span the full outer footprint, the sides cover the corners.
-    addWall(scene, {-t, 0.0f, zFront}, (size.x + 2 * t) * X, depth * Z, Y, t, noHole,
-            addMaterial(scene, "floor", albedo(p.floor.value_or(p.white))));
-    addWall(scene, {-t, size.y, zFront}, (size.x + 2 * t) * X, depth * Z, -Y, t, noHole,
-            addMaterial(scene, "ceiling", albedo(p.white)));
-    addWall(scene, {0.0f, 0.0f, size.z}, size.x * X, size.y * Y, -Z, t, p.opening,
-            addMaterial(scene, "backWall", albedo(p.white)));
-    addWall(scene, {0.0f, 0.0f, zFront}, depth * Z, size.y * Y, X, t, noHole,
-            addMaterial(scene, "rightWall", albedo(p.green)));
-    addWall(scene, {size.x, 0.0f, zFront}, depth * Z, size.y * Y, -X, t, noHole,
-            addMaterial(scene, "leftWall", albedo(p.red)));
+    appendWall(scene, {-t, 0.0f, zFront}, (size.x + 2 * t) * X, depth * Z, Y, t, noHole,
+               appendLambertianMaterial(scene, "floor", albedo(p.floor.value_or(p.white))));
+    appendWall(scene, {-t, size.y, zFront}, (size.x + 2 * t) * X, depth * Z, -Y, t, noHole,
+               appendLambertianMaterial(scene, "ceiling", albedo(p.white)));
+    appendWall(scene, {0.0f, 0.0f, size.z}, size.x * X, size.y * Y, -Z, t, p.opening,
+               appendLambertianMaterial(scene, "backWall", albedo(p.white)));
+    appendWall(scene, {0.0f, 0.0f, zFront}, depth * Z, size.y * Y, X, t, noHole,
+               appendLambertianMaterial(scene, "rightWall", albedo(p.green)));
+    appendWall(scene, {size.x, 0.0f, zFront}, depth * Z, size.y * Y, -X, t, noHole,
+               appendLambertianMaterial(scene, "leftWall", albedo(p.red)));
     if (p.frontWall) {
-        addWall(scene, {0.0f, 0.0f, 0.0f}, size.x * X, size.y * Y, Z, t, noHole,
-                addMaterial(scene, "frontWall", albedo(p.white)));
+        appendWall(scene, {0.0f, 0.0f, 0.0f}, size.x * X, size.y * Y, Z, t, noHole,
+                   appendLambertianMaterial(scene, "frontWall", albedo(p.white)));
     }
     if (p.blocks) {
-        addBlock(scene, kShortBlock, addMaterial(scene, "shortBox", albedo(p.white)));
-        addBlock(scene, kTallBlock, addMaterial(scene, "tallBox", albedo(p.white)));
+        addBlock(scene, kShortBlock, appendLambertianMaterial(scene, "shortBox", albedo(p.white)));
+        addBlock(scene, kTallBlock, appendLambertianMaterial(scene, "tallBox", albedo(p.white)));
     }
 
     // The light: a one-sided emitter facing down, just below the ceiling
     if (p.light) {
-        const uint32_t m = addMaterial(scene, "light", glm::vec3(0.78f));
+        const uint32_t m = appendLambertianMaterial(scene, "light", glm::vec3(0.78f));
         scene.materials[m].emissiveFactor = p.lightRadiance;
         scene.materials[m].doubleSided = false;
         const glm::vec2 centre = 0.5f * (kLightHi + kLightLo) * kMm;

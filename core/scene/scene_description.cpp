@@ -352,10 +352,14 @@ SceneDescription parseSceneDescription(const JsonNode& root, const std::string& 
     } else {
         const JsonNode proc = root["procedural"];
         const std::string generator = proc["generator"].string();
-        if (generator != "cornell_box") {
-            proc["generator"].fail("unknown generator \"" + generator + "\" (cornell_box)");
+        if (generator == "cornell_box") {
+            d.cornellBox = cornellBoxParamsFromJson(proc);
+        } else if (generator == "two_rooms") {
+            d.twoRooms = twoRoomsParamsFromJson(proc);
+        } else {
+            proc["generator"].fail("unknown generator \"" + generator +
+                                   "\" (cornell_box, two_rooms)");
         }
-        d.cornellBox = cornellBoxParamsFromJson(proc);
     }
 
     if (root.has("camera")) d.camera = parseCamera(root["camera"]);

@@ -10,6 +10,7 @@
 #include <glm/glm.hpp>
 
 #include "core/scene/procedural_cornell.h"
+#include "core/scene/procedural_rooms.h"
 #include "core/scene/scene.h"
 
 namespace gilab {
@@ -48,7 +49,8 @@ struct SceneDescription {
     std::string context;  // "scenes/x.json" or `scenes/x.json (variant "spot")`, for messages
     std::optional<std::string> name;
     std::string gltfPath;  // resolved against the file's folder; empty when procedural
-    std::optional<CornellBoxParams> cornellBox;
+    std::optional<CornellBoxParams> cornellBox;  // "procedural": at most one generator is set
+    std::optional<TwoRoomsParams> twoRooms;
     std::optional<CameraOverride> camera;
     std::optional<glm::ivec2> resolution;
     std::optional<float> exposureEv;

@@ -94,9 +94,9 @@ void applyCamera(Scene& scene, const SceneDescription& d, bool sourceHasCamera) 
 Scene buildScene(const SceneDescription& d) {
     Scene scene;
     bool hasCamera = true;
-    if (d.cornellBox) {
+    if (d.cornellBox || d.twoRooms) {
         try {
-            scene = makeCornellBox(*d.cornellBox);
+            scene = d.cornellBox ? makeCornellBox(*d.cornellBox) : makeTwoRooms(*d.twoRooms);
         } catch (const Error& e) {
             throw Error(d.context + ": \"procedural\": " + e.what());
         }
