@@ -2,6 +2,9 @@
 // scene_topology.h) on real scenes: GPU voxelization, then the CPU skeleton pipeline.
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <set>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -12,9 +15,12 @@
 #include "tests/temp_dir.h"
 
 #include "core/gpu/gpu_scene.h"
+#include "core/passes/shared_passes.h"
 #include "core/scene/procedural_cornell.h"
 #include "core/scene/scene.h"
+#include "core/scene/scene_loader.h"
 #include "techniques/topovpl/nearest_node.h"
+#include "techniques/topovpl/pixel_clusters.h"
 #include "techniques/topovpl/scene_topology.h"
 #include "techniques/topovpl/topology_export.h"
 
@@ -90,6 +96,63 @@ TEST_F(GpuTopology, CornellBoxTopologyLabelsTheEmptySpace) {
         }
     }
     EXPECT_EQ(model.meshes.size(), t.gates.empty() ? 2u : 3u);
+}
+
+// The two-room stress scene: the camera in room B sees room A's floor through the door. Every
+// covered pixel (seen from the camera in room B, room A through the door) gets a valid cluster,
+// and some pixels deep in each room sit in clusters of their own room only. Not all: the
+// doorway's cluster reaches deep into both rooms here (docs/techniques/topovpl.md, open).
+TEST_F(GpuTopology, EveryTwoRoomPixelGetsACluster) {
+    Scene scene =
+        loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/stress/two_rooms_door.json", "");
+    scene.computeCaps();
+    vk::GpuScene gpuScene(*m_ctx, scene);
+    topo::TopologySettings s;
+    s.resolution = 64;
+    const topo::SceneTopology t =
+        topo::buildSceneTopology(*m_ctx, gpuScene, scene, s, printTimer());
+    std::printf("two rooms 64^3: %u clusters, %zu gates\n", t.segmentation.clusterCount,
+                t.gates.size());
+    const uint32_t w = uint32_t(scene.settings.width), h = uint32_t(scene.settings.height);
+    SharedPasses passes(*m_ctx, gpuScene, w, h);
+    topo::PixelClusters pixels(*m_ctx, passes.gbuffer(), t, "test");
+    m_ctx->submitAndWait([&](VkCommandBuffer cmd) {
+        passes.record(cmd, scene.camera);
+        pixels.record(cmd, scene.camera.position);
+    });
+    const std::vector<float> pos = passes.gbuffer().position.readbackFloat(*m_ctx);
+    const std::vector<uint8_t> raw = pixels.clusters().readback(*m_ctx);
+    std::vector<uint32_t> ids(size_t(w) * h);
+    ASSERT_EQ(raw.size(), ids.size() * 4);
+    std::memcpy(ids.data(), raw.data(), raw.size());
+    std::vector<std::pair<bool, uint32_t>>
+        deep;  // (in room A, cluster) of pixels far from the wall
+    size_t covered = 0, labelled = 0;
+    const float wallLo = 0.5f, wallHi = 0.52f;  // the dividing wall's x range (generator defaults)
+    for (size_t i = 0; i < size_t(w) * h; ++i) {
+        if (pos[i * 4 + 3] < 0.5f) continue;
+        ++covered;
+        const uint32_t id = ids[i];
+        if (id == topo::kNoNode) continue;
+        ++labelled;
+        ASSERT_LT(id, t.segmentation.clusterCount);
+        const float x = pos[i * 4];
+        if (x < wallLo - 0.2f || x > wallHi + 0.2f) deep.emplace_back(x < wallLo, id);
+    }
+    EXPECT_EQ(labelled, covered);
+    std::set<uint32_t> roomA, roomB;
+    for (const auto& [a, id] : deep)
+        (a ? roomA : roomB).insert(id);
+    size_t apart = 0;  // pixels whose cluster does not appear deep in the other room
+    for (const auto& [a, id] : deep)
+        apart += (a ? roomB : roomA).count(id) == 0;
+    std::printf("%zu pixels deep in the rooms, %zu in clusters of one room only\n", deep.size(),
+                apart);
+    EXPECT_FALSE(roomA.empty());  // room A's floor is seen through the door
+    EXPECT_FALSE(roomB.empty());
+    // Measured 372 of 743 (the doorway's cluster reaches deep into both rooms): recorded as an
+    // open problem of the segmentation (docs/techniques/topovpl.md), checked only for presence.
+    EXPECT_GT(apart, 0u);
 }
 
 }  // namespace
