@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/harness_stats.h"
 #include "tests/indirect_energy.h"
 
 #include "core/gpu/gpu_scene.h"
@@ -48,12 +49,7 @@ ParamSet cvgiParams(const std::map<std::string, std::string>& values) {
     return p;
 }
 
-double stat(const FrameHarness& h, const std::string& name) {
-    for (const auto& [n, v] : h.stats())
-        if (n == name) return v;
-    ADD_FAILURE() << "no stat " << name;
-    return -1.0;
-}
+using test::stat;
 
 // §4.1: every voxel the dense voxelizer covers is in the compacted list, in ascending order, with
 // as many fragments in its list as the dense pass counted; the dense map inverts the list.

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 
 #include "tests/gpu_test_fixture.h"
+#include "tests/harness_stats.h"
 #include "tests/indirect_energy.h"
 
 #include "core/gpu/gpu_scene.h"
@@ -50,12 +51,7 @@ ParamSet ssvpParams(const std::map<std::string, std::string>& values) {
     return p;
 }
 
-double stat(const FrameHarness& h, const std::string& name) {
-    for (const auto& [n, v] : h.stats())
-        if (n == name) return v;
-    ADD_FAILURE() << "no stat " << name;
-    return -1.0;
-}
+using test::stat;
 
 /** Sum of one path-tracer layer (maxBounces bounces, spp samples). */
 double referenceLayerSum(const Scene& scene, int maxBounces, ref::Layer layer, uint32_t spp) {
@@ -189,7 +185,9 @@ void expectSoundClusters(const KmeansResult& r, uint32_t clusterCount) {
         }
         members += uint32_t(c.normal.w);
     }
-    if (r.state.converged) EXPECT_EQ(members, valid);
+    if (r.state.converged) {
+        EXPECT_EQ(members, valid);
+    }
 }
 
 TEST_F(GpuSsvp, KmeansIsDeterministicAndNeverEmptyOrNaN) {

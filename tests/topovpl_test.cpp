@@ -40,16 +40,20 @@ topo::StepTimer printTimer() {
     };
 }
 
+/** The scene's topology at 64^3, each step's time printed. */
+topo::SceneTopology topology64(vk::Context& ctx, const vk::GpuScene& gpuScene, const Scene& scene) {
+    topo::TopologySettings s;
+    s.resolution = 64;
+    return topo::buildSceneTopology(ctx, gpuScene, scene, s, printTimer());
+}
+
 // The Cornell box (closed but for its front, two boxes inside) at 64^3: a skeleton, clusters that
 // cover every node, and every empty voxel that a skeleton voxel reaches gets a cluster.
 TEST_F(GpuTopology, CornellBoxTopologyLabelsTheEmptySpace) {
     Scene scene = makeCornellBox(CornellBoxParams{});
     scene.computeCaps();
     vk::GpuScene gpuScene(*m_ctx, scene);
-    topo::TopologySettings s;
-    s.resolution = 64;
-    const topo::SceneTopology t =
-        topo::buildSceneTopology(*m_ctx, gpuScene, scene, s, printTimer());
+    const topo::SceneTopology t = topology64(*m_ctx, gpuScene, scene);
     std::printf(
         "Cornell 64^3: %u empty, %u solid voxels, %u skeleton voxels, %zu nodes, %zu kept, "
         "%u clusters, %zu gates\n",
@@ -107,10 +111,7 @@ TEST_F(GpuTopology, EveryTwoRoomPixelGetsACluster) {
         loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/stress/two_rooms_door.json", "");
     scene.computeCaps();
     vk::GpuScene gpuScene(*m_ctx, scene);
-    topo::TopologySettings s;
-    s.resolution = 64;
-    const topo::SceneTopology t =
-        topo::buildSceneTopology(*m_ctx, gpuScene, scene, s, printTimer());
+    const topo::SceneTopology t = topology64(*m_ctx, gpuScene, scene);
     std::printf("two rooms 64^3: %u clusters, %zu gates\n", t.segmentation.clusterCount,
                 t.gates.size());
     const uint32_t w = uint32_t(scene.settings.width), h = uint32_t(scene.settings.height);

@@ -30,6 +30,17 @@ bool isDepthFormat(VkFormat format);
 bool hasStencil(VkFormat format);
 /** Full mip chain length for a size. */
 uint32_t fullMipCount(uint32_t width, uint32_t height, uint32_t depth = 1);
+/** The description of a plain 2D image (one mip, one layer). */
+inline ImageDesc imageDesc2D(uint32_t width, uint32_t height, VkFormat format,
+                             VkImageUsageFlags usage, std::string name) {
+    ImageDesc d;
+    d.format = format;
+    d.width = width;
+    d.height = height;
+    d.usage = usage;
+    d.name = std::move(name);
+    return d;
+}
 
 class Image {
 public:

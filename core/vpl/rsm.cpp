@@ -23,17 +23,6 @@ struct VplPush {  // mirrors rsm_vpls.comp
     uint32_t light, count, first, perspective;
 };
 
-vk::Image layer(vk::Context& ctx, uint32_t size, VkFormat format, VkImageUsageFlags usage,
-                const std::string& name) {
-    vk::ImageDesc d;
-    d.format = format;
-    d.width = size;
-    d.height = size;
-    d.usage = usage;
-    d.name = name;
-    return vk::Image(ctx, d);
-}
-
 glm::vec3 row(const glm::mat4& m, int r) {
     return {m[0][r], m[1][r], m[2][r]};
 }
@@ -75,11 +64,14 @@ ReflectiveShadowMap::ReflectiveShadowMap(vk::Context& ctx, const vk::GpuScene& s
     if (size == 0) throw Error(tag + ": empty reflective shadow map");
     const VkImageUsageFlags color =
         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_STORAGE_BIT;
-    m_position = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.position");
-    m_normal = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.normal");
-    m_albedo = layer(ctx, size, VK_FORMAT_R32G32B32A32_SFLOAT, color, tag + "/rsm.albedo");
-    m_depth = layer(ctx, size, VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT,
-                    tag + "/rsm.depth");
+    auto layer = [&](VkFormat format, VkImageUsageFlags usage, const std::string& name) {
+        return vk::Image(ctx, vk::imageDesc2D(size, size, format, usage, tag + name));
+    };
+    m_position = layer(VK_FORMAT_R32G32B32A32_SFLOAT, color, "/rsm.position");
+    m_normal = layer(VK_FORMAT_R32G32B32A32_SFLOAT, color, "/rsm.normal");
+    m_albedo = layer(VK_FORMAT_R32G32B32A32_SFLOAT, color, "/rsm.albedo");
+    m_depth =
+        layer(VK_FORMAT_D32_SFLOAT, VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, "/rsm.depth");
 
     m_rasterLayout = vk::PipelineLayout(ctx, {scene.layout().handle()}, sizeof(RsmPush));
     vk::GraphicsPipelineDesc p;

@@ -23,16 +23,6 @@ struct BlurPush {  // mirrors vpl_blur.comp
 
 constexpr uint32_t kGroup = 8;
 
-vk::Image frameImage(vk::Context& ctx, uint32_t w, uint32_t h, const std::string& name) {
-    vk::ImageDesc d;
-    d.format = VK_FORMAT_R32G32B32A32_SFLOAT;
-    d.width = w;
-    d.height = h;
-    d.usage = VK_IMAGE_USAGE_STORAGE_BIT;
-    d.name = name;
-    return vk::Image(ctx, d);
-}
-
 uint32_t groupCount(uint32_t w, uint32_t h) {
     return ((w + kGroup - 1) / kGroup) * ((h + kGroup - 1) / kGroup);
 }
@@ -42,8 +32,12 @@ uint32_t groupCount(uint32_t w, uint32_t h) {
 VplShading::VplShading(vk::Context& ctx, GBuffer& gbuffer, const vk::Buffer& vpls,
                        const vk::Buffer& clusters, ParaboloidMaps* maps, const std::string& tag)
     : m_width(gbuffer.width), m_height(gbuffer.height), m_hasMaps(maps != nullptr) {
-    m_irradiance = frameImage(ctx, m_width, m_height, tag + "/irradiance");
-    m_temp = frameImage(ctx, m_width, m_height, tag + "/irradiance_blur");
+    auto frameImage = [&](const std::string& name) {
+        return vk::Image(ctx, vk::imageDesc2D(m_width, m_height, VK_FORMAT_R32G32B32A32_SFLOAT,
+                                              VK_IMAGE_USAGE_STORAGE_BIT, tag + name));
+    };
+    m_irradiance = frameImage("/irradiance");
+    m_temp = frameImage("/irradiance_blur");
     m_partials = vk::Buffer(ctx, VkDeviceSize(groupCount(m_width, m_height)) * 16,
                             VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::Readback,
                             tag + "/clamp_sums");

@@ -7,21 +7,6 @@
 #include "techniques/topovpl/scene_topology.h"
 
 namespace gilab::topo {
-namespace {
-
-vk::Image frameImage(vk::Context& ctx, uint32_t w, uint32_t h, VkFormat format,
-                     const std::string& name) {
-    vk::ImageDesc d;
-    d.format = format;
-    d.width = w;
-    d.height = h;
-    d.usage = VK_IMAGE_USAGE_STORAGE_BIT;
-    d.name = name;
-    return vk::Image(ctx, d);
-}
-
-}  // namespace
-
 PixelClusters::PixelClusters(vk::Context& ctx, GBuffer& gbuffer, const SceneTopology& t,
                              const std::string& tag)
     : m_width(gbuffer.width), m_height(gbuffer.height), m_grid(t.grid) {
@@ -36,9 +21,12 @@ PixelClusters::PixelClusters(vk::Context& ctx, GBuffer& gbuffer, const SceneTopo
         ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
         vk::MemoryUsage::DeviceLocal, tag + "/voxel_clusters");
     m_voxelClusters.uploadVector(t.voxelCluster);
-    m_clusters = frameImage(ctx, m_width, m_height, VK_FORMAT_R32_UINT, tag + "/pixel_clusters");
-    m_debug =
-        frameImage(ctx, m_width, m_height, VK_FORMAT_R32G32B32A32_SFLOAT, tag + "/cluster_view");
+    auto frameImage = [&](VkFormat format, const std::string& name) {
+        return vk::Image(ctx, vk::imageDesc2D(m_width, m_height, format, VK_IMAGE_USAGE_STORAGE_BIT,
+                                              tag + name));
+    };
+    m_clusters = frameImage(VK_FORMAT_R32_UINT, "/pixel_clusters");
+    m_debug = frameImage(VK_FORMAT_R32G32B32A32_SFLOAT, "/cluster_view");
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
         m_clusters.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
         m_debug.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
