@@ -1,6 +1,7 @@
 // The topology cache (techniques/topovpl/topology_cache.h): exact round trips of a synthetic
 // SceneTopology, misses, corrupt files rejected with a reason, and what the key depends on.
 // CPU only.
+#include <algorithm>
 #include <bit>
 #include <cstdint>
 #include <cstdlib>
@@ -59,8 +60,8 @@ SceneTopology syntheticTopology() {
     t.solidVoxels = uint32_t(t.dims.count()) - t.emptyVoxels;
     const float v = t.grid.voxelSize();
     for (const topo::Gate& g : t.segmentation.gates)
-        t.gates.push_back(
-            {t.grid.gridToWorld(g.centre + 0.5f), g.normal, g.radius * v, g.clusterA, g.clusterB});
+        t.gates.push_back({t.grid.gridToWorld(g.centre + 0.5f), g.normal, g.radius * v,
+                           g.radiusA * v, g.radiusB * v, g.clusterA, g.clusterB, g.radiusNeck * v});
     return t;
 }
 
@@ -85,7 +86,10 @@ std::vector<uint32_t> bits(const std::vector<G>& gates) {
             out.push_back(std::bit_cast<uint32_t>(g.centre[k]));
         for (int k = 0; k < 3; ++k)
             out.push_back(std::bit_cast<uint32_t>(g.normal[k]));
+        out.push_back(std::bit_cast<uint32_t>(g.radiusNeck));
         out.push_back(std::bit_cast<uint32_t>(g.radius));
+        out.push_back(std::bit_cast<uint32_t>(g.radiusA));
+        out.push_back(std::bit_cast<uint32_t>(g.radiusB));
         out.push_back(g.clusterA);
         out.push_back(g.clusterB);
     }
@@ -115,6 +119,7 @@ void expectSame(const SceneTopology& a, const SceneTopology& b) {
     EXPECT_EQ(s.segmentedAdjacency, r.segmentedAdjacency);
     EXPECT_EQ(s.cluster, r.cluster);
     EXPECT_EQ(s.clusterCount, r.clusterCount);
+    EXPECT_EQ(s.greedyClusters, r.greedyClusters);
     EXPECT_EQ(bits(s.gates), bits(r.gates));
     EXPECT_EQ(s.curvatureNodes, r.curvatureNodes);
     EXPECT_EQ(s.coverageNodes, r.coverageNodes);
@@ -171,7 +176,7 @@ struct Tail {
 };
 Tail tailOffsets(const std::string& bytes, const SceneTopology& t) {
     Tail o;
-    o.worldGatesLength = bytes.size() - 16 - t.gates.size() * 36 - 8;
+    o.worldGatesLength = bytes.size() - 16 - t.gates.size() * 48 - 8;
     o.lastGateClusterB = bytes.size() - 16 - 4;
     o.voxelClusterLength = o.worldGatesLength - t.voxelCluster.size() * 4 - 8;
     o.lastVoxelCluster = o.worldGatesLength - 4;
@@ -184,6 +189,22 @@ TEST(CpuTopologyCache, SyntheticTopologyIsNotTrivial) {
     EXPECT_FALSE(t.segmentation.gates.empty());
     EXPECT_GE(t.segmentation.kept.size(), 3u);
     EXPECT_GT(t.graph.position.size(), t.segmentation.kept.size());
+    // Both end radii are kept, and differ on some gate (the thin and the wide arm), so the round
+    // trip below tells radiusA from radiusB.
+    bool unequal = false;
+    for (size_t i = 0; i < t.gates.size(); ++i) {
+        const topo::Gate& g = t.segmentation.gates[i];
+        EXPECT_EQ(g.radius, std::min(g.radiusA, g.radiusB));
+        EXPECT_GT(g.radiusA, 0.0f);
+        EXPECT_GT(g.radiusB, 0.0f);
+        EXPECT_EQ(t.gates[i].radiusA, g.radiusA * t.grid.voxelSize());
+        EXPECT_EQ(t.gates[i].radiusB, g.radiusB * t.grid.voxelSize());
+        EXPECT_GT(g.radiusNeck, 0.0f);
+        EXPECT_LE(g.radiusNeck, g.radius);
+        unequal = unequal || g.radiusA != g.radiusB;
+    }
+    EXPECT_TRUE(unequal);
+    EXPECT_EQ(t.segmentation.greedyClusters, t.segmentation.clusterCount);  // no merge here
 }
 
 TEST(CpuTopologyCache, StoreAndLoadRoundTripEveryField) {
@@ -219,7 +240,10 @@ TEST(CpuTopologyCache, StoreReplacesAnEntry) {
     SceneTopology t = syntheticTopology();
     topo::storeTopology(dir.path(), kKey, t);
     t.graph.prunedNodes = 99;
+    t.gates.front().radiusA = 0.25f;
+    t.gates.front().radiusB = 0.125f;
     t.gates.front().radius = 0.125f;
+    t.gates.front().radiusNeck = 0.0625f;
     topo::storeTopology(dir.path(), kKey, t);
     const std::optional<SceneTopology> loaded = topo::loadTopology(dir.path(), kKey);
     ASSERT_TRUE(loaded.has_value());
@@ -307,6 +331,14 @@ TEST(CpuTopologyCache, InconsistentContentIsRejected) {
         resealChecksum(bytes);
     });
     EXPECT_NE(why.find("voxelCluster["), std::string::npos) << why;
+    // A world gate whose radius is not the minimum of its end radii (the last gate's radiusB,
+    // 8 bytes before its clusterB, set to half its radius).
+    why = rejectionOf(t, [&](std::string& bytes) {
+        const size_t at = tailOffsets(bytes, t).lastGateClusterB - 8;
+        putU32(bytes, at, std::bit_cast<uint32_t>(t.gates.back().radius * 0.5f));
+        resealChecksum(bytes);
+    });
+    EXPECT_NE(why.find("end radii"), std::string::npos) << why;
     // Another entry's file under this key.
     why = rejectionOf(t, [&](std::string& bytes) {
         bytes[20] = bytes[20] == 'f' ? 'e' : 'f';
@@ -424,6 +456,12 @@ TEST(CpuTopologyKey, ChangesWithGeometryAndSettings) {
     other = settings;
     other.alpha = 0.25f;
     EXPECT_NE(topo::topologyKey(keyScene(), other), base);
+    other = settings;
+    EXPECT_TRUE(other.mergeVisible);  // the default: our visibility merge
+    other.mergeVisible = false;
+    const std::string literal = topo::topologyKey(keyScene(), other);
+    EXPECT_NE(literal, base);
+    EXPECT_EQ(topo::topologyKey(keyScene(), other), literal);
 }
 
 TEST(CpuTopologyKey, IgnoresMaterialsLightsCameraAndImage) {

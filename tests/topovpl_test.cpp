@@ -151,9 +151,9 @@ TEST_F(GpuTopology, EveryTwoRoomPixelGetsACluster) {
                 apart);
     EXPECT_FALSE(roomA.empty());  // room A's floor is seen through the door
     EXPECT_FALSE(roomB.empty());
-    // Measured 372 of 743 (the doorway's cluster reaches deep into both rooms): recorded as an
-    // open problem of the segmentation (docs/techniques/topovpl.md), checked only for presence.
-    EXPECT_GT(apart, 0u);
+    // Every pixel deep in a room is in a cluster of that room only (with the gate at the doorway;
+    // before it, 372 of 743: the doorway's cluster reached deep into both rooms).
+    EXPECT_EQ(apart, deep.size());
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "core/util/progress.h"
 #include "core/vk/context.h"
 #include "core/vk/image.h"
+#include "core/vpl/vpl.h"
 
 namespace gilab {
 namespace {
@@ -229,6 +230,16 @@ std::vector<ImageLayer> FrameHarness::readLayers() {
     for (const DebugView& view : m_technique->debugViews())
         if (view.image) layers.push_back({"debug_" + view.name, readImage(m_ctx, *view.image, 3)});
     return layers;
+}
+
+bool FrameHarness::readVplFrame(VplSet& vpls, Image& position, Image& normal, Image& albedo) {
+    if (!m_ready) throw Error("FrameHarness::readVplFrame() called before setup()");
+    if (!m_technique->readVplSet(vpls)) return false;
+    GBuffer& gb = m_shared->gbuffer();
+    position = readImage(m_ctx, gb.position, 4);
+    normal = readImage(m_ctx, gb.normal, 3);
+    albedo = readImage(m_ctx, gb.albedo, 3);
+    return true;
 }
 
 MemoryReport FrameHarness::memory() const {

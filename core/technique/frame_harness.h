@@ -88,6 +88,12 @@ public:
     /** final, indirect, direct, emission, albedo, normal, depth, then the debug views. */
     std::vector<ImageLayer> readLayers();
 
+    /**
+     * A VPL technique's last frame for the same-VPL reference: its VPL set and the G-buffer's
+     * world position (xyzw), shading normal and albedo. False when the technique has no VPLs.
+     */
+    bool readVplFrame(VplSet& vpls, Image& position, Image& normal, Image& albedo);
+
     const std::vector<std::string>& skipped() const { return m_skipped; }
     const std::vector<std::string>& notes() const { return m_notes; }
     /** Named numbers the technique reported (TechniqueContext::stat). */

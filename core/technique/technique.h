@@ -34,6 +34,7 @@ namespace gilab {
 
 struct Scene;
 struct SceneChanges;
+struct VplSet;
 
 class SharedPasses;
 struct GBuffer;
@@ -182,6 +183,12 @@ public:
      *  (e.g. counters) and record them with ctx.stat. Default: nothing. */
     virtual void frameFinished(TechniqueContext& ctx) { (void)ctx; }
     virtual std::vector<DebugView> debugViews() { return {}; }
+    /** VPL techniques: the last frame's VPLs as the gather used them (read back after the
+     *  frame), for the same-VPL shadow-ray reference. Default: false (not a VPL technique). */
+    virtual bool readVplSet(VplSet& out) {
+        (void)out;
+        return false;
+    }
 
     const TechniqueInfo& info() const { return m_info; }
 

@@ -1,6 +1,7 @@
 #include "core/vpl/rsm.h"
 
 #include <cmath>
+#include <string>
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/pass_light.h"
@@ -56,6 +57,37 @@ glm::mat4 fitOrthoToBounds(const glm::mat4& viewProj, const Bounds& b) {
 }
 
 }  // namespace
+
+int rsmMainLight(const Scene& scene, int requested, std::string* why) {
+    constexpr float kMaxSpotOuterRad = 1.4835299f;  // 85 deg: wider spots have no 2D view
+    auto candidate = [&](const Light& l) {
+        return l.type == LightType::Directional ||
+               (l.type == LightType::Spot && l.outerConeRad <= kMaxSpotOuterRad);
+    };
+    if (requested >= 0) {
+        if (requested >= int(scene.lights.size())) {
+            if (why)
+                *why = "light = " + std::to_string(requested) + " but the scene has " +
+                       std::to_string(scene.lights.size()) + " light(s)";
+            return -1;
+        }
+        if (!candidate(scene.lights[size_t(requested)])) {
+            if (why)
+                *why = "light " + std::to_string(requested) + " ('" +
+                       scene.lights[size_t(requested)].name +
+                       "') is not a spot (<= 85 deg) or directional light: it has no RSM view";
+            return -1;
+        }
+        return requested;
+    }
+    for (size_t i = 0; i < scene.lights.size(); ++i)
+        if (candidate(scene.lights[i])) return int(i);
+    if (why)
+        *why =
+            "needs a spot (<= 85 deg) or directional light for its reflective shadow map (the "
+            "VPLs' main light)";
+    return -1;
+}
 
 ReflectiveShadowMap::ReflectiveShadowMap(vk::Context& ctx, const vk::GpuScene& scene,
                                          const vk::Buffer& passLights, uint32_t size,

@@ -29,6 +29,14 @@ class Context;
 class GpuScene;
 }  // namespace vk
 struct PassLight;
+struct Scene;
+
+/**
+ * The scene light a VPL technique renders its RSM from: `requested` (a scene light index) when
+ * it is >= 0, else the first spot (outer cone <= 85 deg) or directional light. Returns -1 with
+ * the reason in `*why` when there is none or `requested` cannot have an RSM.
+ */
+int rsmMainLight(const Scene& scene, int requested, std::string* why);
 
 class ReflectiveShadowMap {
 public:

@@ -9,6 +9,8 @@
  * I(w) = flux max(0, n.w) / pi [W/sr], so a receiver at distance d gets the irradiance
  * E = flux cos(theta) cos(sigma) / (pi d^2) [W/m^2].
  */
+#include <vector>
+
 #include <glm/glm.hpp>
 
 namespace gilab {
@@ -27,5 +29,15 @@ struct GpuVplCluster {
     glm::vec4 mean{0.0f};      // xyz member mean (before the eye offset)
 };
 static_assert(sizeof(GpuVplCluster) == 64);
+
+/**
+ * A technique's VPLs of the last frame as its gather shades them, for the same-VPL reference
+ * (reference/vpl_reference.h: the same VPLs with exact shadow rays, Noël & Biri 2014 Table II).
+ */
+struct VplSet {
+    std::vector<GpuVpl> vpls;
+    float clampDistance = 0.0f;         // d_min of the gather, world units (0 = none)
+    glm::vec2 bounceScale{1.0f, 1.0f};  // flux multiplier of bounce-1 and bounce-2 VPLs
+};
 
 }  // namespace gilab

@@ -104,7 +104,8 @@ ReferenceRequest parseReference(const JsonNode& node) {
 
 MetricOptionsSpec parseMetrics(const JsonNode& node) {
     MetricOptionsSpec m;
-    node.expectKeys({"ppd", "exposure_ev", "regions"});
+    node.expectKeys({"ppd", "exposure_ev", "regions", "same_vpl_reference"});
+    if (node.has("same_vpl_reference")) m.sameVplReference = node["same_vpl_reference"].boolean();
     if (node.has("ppd")) m.ppd = node["ppd"].numberIn(1.0, 1000.0);
     if (node.has("exposure_ev")) m.exposureEv = float(node["exposure_ev"].numberIn(-40.0, 40.0));
     if (node.has("regions")) {
@@ -297,7 +298,11 @@ nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec) {
             j["indirect_fraction_above"] = r.indirectFractionAbove;
         regions.push_back(j);
     }
-    return {{"ppd", spec.ppd}, {"exposure_ev", spec.exposureEv}, {"regions", regions}};
+    nlohmann::ordered_json out = {
+        {"ppd", spec.ppd}, {"exposure_ev", spec.exposureEv}, {"regions", regions}};
+    // Only when on, so the identity (run key) of every run without it is unchanged.
+    if (spec.sameVplReference) out["same_vpl_reference"] = true;
+    return out;
 }
 
 ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::string& context,

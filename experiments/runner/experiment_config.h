@@ -51,6 +51,9 @@ struct MetricOptionsSpec {
     double ppd = 67.0;
     float exposureEv = 0.0f;  // LDR metrics and previews; added to the scene's exposure
     std::vector<RegionSpec> regions;
+    /** VPL techniques: shade their VPLs with exact shadow rays too (experiments/runner/
+     *  same_vpl.h, the Table II reference of Noël & Biri 2014). */
+    bool sameVplReference = false;
 };
 
 /** One technique block: fixed parameters plus sweeps (grid = cartesian, zip = lock-step). */

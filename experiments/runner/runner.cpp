@@ -25,6 +25,7 @@
 #include "experiments/runner/run_metrics.h"
 #include "experiments/runner/run_sequence.h"
 #include "experiments/runner/run_store.h"
+#include "experiments/runner/same_vpl.h"
 #include "experiments/runner/timing_probe.h"
 #include "reference/scene_hash.h"
 
@@ -327,7 +328,10 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     }
     progress.finish();
 
-    const std::vector<ImageLayer> layers = harness->readLayers();
+    std::vector<ImageLayer> layers = harness->readLayers();
+    nlohmann::ordered_json sameVpl = nullptr;
+    if (c.config.metrics.sameVplReference)
+        sameVpl = computeSameVplReference(*harness, harness->scene(), layers, tm);
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
     result["timing"] = cli::timingJson(setup, frames, c.config.timing.warmupFrames);
@@ -367,6 +371,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                                           c.config.metrics, tm, tmp);
     result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
     result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
+    if (!sameVpl.is_null()) result["metrics"]["same_vpl"] = sameVpl;
 
     writeExrWithMainImage((tmp / "output.exr").string(), layers, "final");
     writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);

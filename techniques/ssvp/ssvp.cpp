@@ -21,40 +21,7 @@
 namespace gilab {
 namespace {
 
-constexpr float kCubeSpotOuterRad = 1.4835299f;  // spots wider than 85 deg have no 2D view
 constexpr float kDegToRad = 0.017453292519943295f;
-
-bool mainLightCandidate(const Light& l) {
-    return l.type == LightType::Directional ||
-           (l.type == LightType::Spot && l.outerConeRad <= kCubeSpotOuterRad);
-}
-
-/** The scene light the RSM is rendered from: `requested`, or the first candidate. */
-int mainLight(const Scene& scene, int requested, std::string* why) {
-    if (requested >= 0) {
-        if (requested >= int(scene.lights.size())) {
-            if (why)
-                *why = "light = " + std::to_string(requested) + " but the scene has " +
-                       std::to_string(scene.lights.size()) + " light(s)";
-            return -1;
-        }
-        if (!mainLightCandidate(scene.lights[size_t(requested)])) {
-            if (why)
-                *why = "light " + std::to_string(requested) + " ('" +
-                       scene.lights[size_t(requested)].name +
-                       "') is not a spot (<= 85 deg) or directional light: it has no RSM view";
-            return -1;
-        }
-        return requested;
-    }
-    for (size_t i = 0; i < scene.lights.size(); ++i)
-        if (mainLightCandidate(scene.lights[i])) return int(i);
-    if (why)
-        *why =
-            "needs a spot (<= 85 deg) or directional light for its reflective shadow map (the "
-            "paper's main light)";
-    return -1;
-}
 
 float sceneDiagonal(const Scene& scene) {
     const Bounds& b = scene.caps.bounds;
@@ -97,7 +64,7 @@ TechniqueInfo SsvpTechnique::describe() {
 
 SupportResult SsvpTechnique::checkSupport(const Scene& scene, const ParamSet& params) const {
     std::string why;
-    if (mainLight(scene, int(params.getInt("light")), &why) < 0) return {false, why};
+    if (rsmMainLight(scene, int(params.getInt("light")), &why) < 0) return {false, why};
     return {};
 }
 
@@ -106,7 +73,7 @@ void SsvpTechnique::setup(TechniqueContext& ctx) {
     m_settings = ssvpSettingsFrom(ctx.params);
     const SsvpSettings& s = m_settings;
     std::string why;
-    const int light = mainLight(ctx.scene, s.light, &why);
+    const int light = rsmMainLight(ctx.scene, s.light, &why);
     if (light < 0) throw Error("ssvp: " + why);
     auto gpu = std::make_unique<SsvpGpu>();
     gpu->light = uint32_t(light);  // scene light i is pass light table entry i
@@ -241,6 +208,17 @@ void SsvpTechnique::frameFinished(TechniqueContext& ctx) {
 std::vector<DebugView> SsvpTechnique::debugViews() {
     if (!m_gpu) return {};
     return {{"irradiance", &m_gpu->shading->irradiance()}};
+}
+
+bool SsvpTechnique::readVplSet(VplSet& out) {
+    if (!m_gpu) return false;
+    const SsvpSettings& s = m_settings;
+    const uint32_t count = s.firstBounceVpls + (s.bounces >= 2 ? s.secondBounceVpls : 0u);
+    out.vpls = m_gpu->vpls.downloadVector<GpuVpl>(count);
+    const VplShadingSettings& v = m_gpu->shading->settings();
+    out.clampDistance = v.clampDistance;
+    out.bounceScale = v.bounceScale;
+    return true;
 }
 
 GILAB_REGISTER_TECHNIQUE(SsvpTechnique)

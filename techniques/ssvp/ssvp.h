@@ -36,6 +36,7 @@ public:
     void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) override;
     void frameFinished(TechniqueContext& ctx) override;
     std::vector<DebugView> debugViews() override;
+    bool readVplSet(VplSet& out) override;
 
 private:
     void applySettings(const TechniqueContext& ctx);

@@ -39,6 +39,9 @@ public:
     void record(VkCommandBuffer cmd, const glm::vec3& eye);
     vk::Image& clusters() { return m_clusters; }
     vk::Image& debugView() { return m_debug; }
+    /** The topology's voxel-cluster grid on the GPU (uint per voxel, 0xFFFFFFFF solid). */
+    const vk::Buffer& voxelClusters() const { return m_voxelClusters; }
+    const VoxelGrid& grid() const { return m_grid; }
 
 private:
     uint32_t m_width, m_height;

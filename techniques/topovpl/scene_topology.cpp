@@ -51,7 +51,11 @@ SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene,
     t.skeletonVoxels = uint32_t(voxels.size());
     time("segmentation", [&] {
         t.graph = buildSkeletonGraph(voxels, radii);
-        t.segmentation = segmentSkeleton(t.graph, s.alpha);
+        t.segmentation = segmentSkeleton(t.graph);
+    });
+    time("clustering", [&] {
+        clusterSkeleton(t.graph, t.segmentation, s.alpha, empty, t.dims, s.mergeVisible,
+                        s.gatePlacement, s.mergeVisibility);
     });
     time("nearest_node", [&] {
         const std::vector<uint32_t> labels =
@@ -63,8 +67,8 @@ SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene,
     // Gates in world units: voxel coordinates are voxel corners; centres are at + 0.5.
     const float v = t.grid.voxelSize();
     for (const Gate& g : t.segmentation.gates)
-        t.gates.push_back(
-            {t.grid.gridToWorld(g.centre + 0.5f), g.normal, g.radius * v, g.clusterA, g.clusterB});
+        t.gates.push_back({t.grid.gridToWorld(g.centre + 0.5f), g.normal, g.radius * v,
+                           g.radiusA * v, g.radiusB * v, g.clusterA, g.clusterB, g.radiusNeck * v});
     return t;
 }
 

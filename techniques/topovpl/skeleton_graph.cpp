@@ -7,6 +7,7 @@
 #include <unordered_map>
 
 #include "core/util/error.h"
+#include "techniques/topovpl/cluster_merge.h"
 
 namespace gilab::topo {
 namespace {
@@ -16,11 +17,7 @@ uint64_t packVoxel(const glm::ivec3& v) {
            uint64_t(uint32_t(v.z) & 0x1FFFFF);
 }
 
-/** A piece of line: extrema a and b (kept nodes) and the degree-2 nodes between them. */
-struct Piece {
-    uint32_t a = 0, b = 0;
-    std::vector<uint32_t> chain;
-};
+using Piece = LinePiece;
 
 /** Distance from p to the straight line through a and b (to a when they coincide). */
 float distanceToChord(const glm::vec3& p, const glm::vec3& a, const glm::vec3& b) {
@@ -304,7 +301,7 @@ SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
     return g;
 }
 
-Segmentation segmentSkeleton(const SkeletonGraph& g, float alpha) {
+Segmentation segmentSkeleton(const SkeletonGraph& g) {
     const uint32_t n = uint32_t(g.position.size());
     Segmentation s;
     s.kind.assign(n, NodeKind::Line);
@@ -325,6 +322,7 @@ Segmentation segmentSkeleton(const SkeletonGraph& g, float alpha) {
     }
     for (auto& a : s.segmentedAdjacency)
         std::sort(a.begin(), a.end());
+    s.pieces = std::move(pieces);
     for (uint32_t i = 0; i < n; ++i) {
         if (s.kind[i] == NodeKind::Line) continue;
         s.kept.push_back(i);
@@ -332,25 +330,79 @@ Segmentation segmentSkeleton(const SkeletonGraph& g, float alpha) {
         s.curvatureNodes += s.kind[i] == NodeKind::Curvature;
         s.coverageNodes += s.kind[i] == NodeKind::Coverage;
     }
+    return s;
+}
+
+void clusterSkeleton(const SkeletonGraph& g, Segmentation& s, float alpha,
+                     const std::vector<uint8_t>& empty, const GridDims& dims, bool mergeVisible,
+                     GatePlacement placement, float mergeThreshold) {
+    const uint32_t n = uint32_t(g.position.size());
+    if (s.kind.size() != n || s.segmentedNode.size() != n || s.segmentedAdjacency.size() != n)
+        throw Error("clusterSkeleton: the segmentation is not of this graph (" +
+                    std::to_string(s.kind.size()) + " nodes, the graph has " + std::to_string(n) +
+                    ")");
+    if (mergeVisible && empty.size() != dims.count())
+        throw Error("clusterSkeleton: " + std::to_string(empty.size()) +
+                    " voxels in the empty grid, dims hold " + std::to_string(dims.count()));
     s.cluster.assign(n, std::numeric_limits<uint32_t>::max());
+    s.clusterCount = 0;
     clusterNodes(g, s, alpha);
     for (uint32_t i = 0; i < n; ++i)
         if (s.kind[i] == NodeKind::Line) s.cluster[i] = s.cluster[s.segmentedNode[i]];
-    // (E4): a gate on every segmented edge between two clusters.
-    for (uint32_t a : s.kept)
-        for (uint32_t b : s.segmentedAdjacency[a]) {
-            if (b <= a || s.cluster[a] == s.cluster[b]) continue;
-            const glm::vec3 d = g.position[b] - g.position[a];
-            const float len = glm::length(d);
-            Gate gate;
-            gate.centre = 0.5f * (g.position[a] + g.position[b]);
-            gate.normal = len > 0.0f ? d / len : glm::vec3(0.0f, 0.0f, 1.0f);
-            gate.radius = std::min(g.maxball[a], g.maxball[b]);
-            gate.clusterA = s.cluster[a];
-            gate.clusterB = s.cluster[b];
-            s.gates.push_back(gate);
-        }
+    s.greedyClusters = s.clusterCount;
+    if (mergeVisible) mergeVisibleClusters(g, s, empty, dims, mergeThreshold);
+    placeGates(g, s, placement);
+}
+
+Segmentation segmentSkeleton(const SkeletonGraph& g, float alpha) {
+    Segmentation s = segmentSkeleton(g);
+    clusterSkeleton(g, s, alpha, {}, GridDims{}, false, GatePlacement::Midpoint);
     return s;
+}
+
+void placeGates(const SkeletonGraph& g, Segmentation& s, GatePlacement placement) {
+    s.gates.clear();
+    for (const LinePiece& p : s.pieces) {
+        if (s.cluster[p.a] == s.cluster[p.b]) continue;
+        // The line from a to b, ends included; its narrowest node (ties: nearest the middle).
+        std::vector<uint32_t> line{p.a};
+        line.insert(line.end(), p.chain.begin(), p.chain.end());
+        line.push_back(p.b);
+        const size_t last = line.size() - 1;
+        size_t neck = 0;
+        for (size_t i = 1; i <= last; ++i) {
+            const float r = g.maxball[line[i]], best = g.maxball[line[neck]];
+            const auto off = [&](size_t k) { return std::abs(2 * long(k) - long(last)); };
+            if (r < best || (r == best && off(i) < off(neck))) neck = i;
+        }
+        Gate gate;
+        gate.radiusA = g.maxball[p.a];
+        gate.radiusB = g.maxball[p.b];
+        gate.radius = std::min(gate.radiusA, gate.radiusB);
+        gate.radiusNeck = g.maxball[line[neck]];
+        gate.clusterA = s.cluster[p.a];
+        gate.clusterB = s.cluster[p.b];
+        glm::vec3 d = g.position[p.b] - g.position[p.a];
+        if (placement == GatePlacement::Midpoint) {
+            gate.centre = 0.5f * (g.position[p.a] + g.position[p.b]);
+        } else {
+            gate.centre = g.position[line[neck]];
+            const glm::vec3 local = g.position[line[std::min(neck + 1, last)]] -
+                                    g.position[line[neck > 0 ? neck - 1 : 0]];
+            if (glm::dot(local, local) > 0.0f) d = local;
+            // The line's nodes before the neck are a's side, after it b's (the neck itself goes
+            // to the nearer end), so the clusters of the pixels meet at the gate.
+            for (size_t i = 1; i < last; ++i) {
+                const uint32_t m = line[i];
+                const bool sideA = i < neck || (i == neck && 2 * neck <= last);
+                s.segmentedNode[m] = sideA ? p.a : p.b;
+                s.cluster[m] = s.cluster[s.segmentedNode[m]];
+            }
+        }
+        const float len = glm::length(d);
+        gate.normal = len > 0.0f ? d / len : glm::vec3(0.0f, 0.0f, 1.0f);
+        s.gates.push_back(gate);
+    }
 }
 
 }  // namespace gilab::topo

@@ -16,8 +16,15 @@
  *   clusters      (E3) greedy: seeds by maxball descending; a neighbour joins when it is not a
  *                 curvature node and |maxball - R_C| <= alpha R_C; every node inside the
  *                 member's maximal ball and reachable through the graph joins too
+ *   merge         (OUR addition, not in the paper; cluster_merge.h) two adjacent clusters merge
+ *                 when every pair of kept nodes of their union (each by its voxel and its ball's
+ *                 six axis poles) sees each other through the empty voxels: the union of their
+ *                 balls is then taken as quasi-convex, which is what a paper cluster stands for.
+ *                 Without it two rooms joined by a door gave 4 clusters and 3 gates (the
+ *                 approaches to the door were clusters of their own); with it, 2 and 1
  *   gates         (E4) a disk on every segmented edge between two clusters: centre the edge's
- *                 midpoint, normal along the edge, radius min(maxball) of its ends
+ *                 midpoint, normal along the edge, radius min(maxball) of its ends (both ends'
+ *                 radii are kept, for a per-frame radius rule)
  *
  * Positions and radii are in voxel units (voxel centres at integer coordinates + 0.5 are the
  * caller's business: positions here are the voxel indices). Deterministic: ties by node index.
@@ -26,6 +33,8 @@
 #include <vector>
 
 #include <glm/glm.hpp>
+
+#include "core/voxel/grid_dims.h"
 
 namespace gilab::topo {
 
@@ -52,10 +61,28 @@ SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
 
 struct Gate {
     glm::vec3 centre{0.0f};
-    glm::vec3 normal{0.0f};  // unit, from node a to node b
-    float radius = 0.0f;
-    uint32_t clusterA = 0, clusterB = 0;  // the clusters of the edge's ends a and b
+    glm::vec3 normal{0.0f};                // unit, from node a's side to node b's
+    float radius = 0.0f;                   // min(radiusA, radiusB)
+    float radiusA = 0.0f, radiusB = 0.0f;  // maxball of the edge's ends a and b
+    uint32_t clusterA = 0, clusterB = 0;   // the clusters of the edge's ends a and b
+    float radiusNeck = 0.0f;               // the smallest maxball on the line from a to b
 };
+
+/** A piece of a skeleton line between two kept nodes a and b: the degree-2 nodes between them,
+ *  in order from a. */
+struct LinePiece {
+    uint32_t a = 0, b = 0;
+    std::vector<uint32_t> chain;
+};
+
+/**
+ * Where a gate sits on its line (E4 places it at the midpoint of the segmented edge):
+ *   Midpoint    the paper: centre (p(a) + p(b)) / 2, normal along b - a
+ *   Bottleneck  ours: the node of smallest maxball on the line from a to b (the doorway; ties:
+ *               the one nearest the middle), normal along the line there; the line's nodes on
+ *               each side of it take that side's cluster, so the pixel clusters meet at the gate
+ */
+enum class GatePlacement : uint8_t { Midpoint = 0, Bottleneck = 1 };
 
 struct Segmentation {
     std::vector<NodeKind> kind;           // per graph node
@@ -64,12 +91,36 @@ struct Segmentation {
     std::vector<std::vector<uint32_t>> segmentedAdjacency;  // per graph node (kept ones only)
     std::vector<uint32_t> cluster;  // per graph node (kept: own, else its kept node's)
     uint32_t clusterCount = 0;
+    uint32_t greedyClusters = 0;  // E3's count, before the visibility merge
     std::vector<Gate> gates;
     uint32_t curvatureNodes = 0, coverageNodes = 0, topologyNodes = 0;
+    /** The pieces of line between kept nodes (set-up only: not stored in the topology cache). */
+    std::vector<LinePiece> pieces;
 };
 
-/** Segments the graph, clusters it with tolerance alpha (0.2 = the paper's 20 %) and places the
- *  gates. */
+/** Segments the graph: lines, curvature (E1) and coverage (E2) nodes, the segmented edges and
+ *  every node's kept node. Clusters and gates are left empty (clusterSkeleton). */
+Segmentation segmentSkeleton(const SkeletonGraph& graph);
+
+/**
+ * Clusters a segmentation (E3) with tolerance alpha (0.2 = the paper's 20 %); with
+ * `mergeVisible`, merges mutually visible adjacent clusters (cluster_merge.h; `empty` is the
+ * empty-voxel grid of `dims`, the graph's positions index it; `mergeThreshold`: the share of
+ * visible sample pairs it needs, cluster_merge.h); then places the gates (E4) by
+ * `placement`. Replaces any clusters and gates `s` had. Without the merge, `empty` is not read
+ * (may be empty).
+ */
+void clusterSkeleton(const SkeletonGraph& graph, Segmentation& s, float alpha,
+                     const std::vector<uint8_t>& empty, const GridDims& dims, bool mergeVisible,
+                     GatePlacement placement = GatePlacement::Midpoint,
+                     float mergeThreshold = 1.0f);
+
+/** segmentSkeleton then clusterSkeleton without the merge: the paper's literal clusters. */
 Segmentation segmentSkeleton(const SkeletonGraph& graph, float alpha);
+
+/** (E4) Recomputes s.gates from s.cluster: one per piece of line between two clusters (two
+ *  parallel lines between the same kept nodes are two gates). Bottleneck placement also moves
+ *  the line's nodes to the cluster of their side of the gate. */
+void placeGates(const SkeletonGraph& graph, Segmentation& s, GatePlacement placement);
 
 }  // namespace gilab::topo

@@ -1,6 +1,8 @@
 #include "techniques/topovpl/topology_cache.h"
 
+#include <algorithm>
 #include <bit>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -23,16 +25,17 @@ namespace fs = std::filesystem;
 
 // A field added to one of these must be serialized below (and kTopologyFormatVersion bumped); a
 // new setting must be hashed in topologyKey. The sizes are those of x86-64 / AArch64.
-static_assert(sizeof(TopologySettings) == 8, "hash the new setting in topologyKey");
+static_assert(sizeof(TopologySettings) == 16, "hash the new setting in topologyKey");
 static_assert(sizeof(SkeletonGraph) == 104, "serialize the new SkeletonGraph field");
-static_assert(sizeof(Gate) == 36, "serialize the new Gate field");
-static_assert(sizeof(Segmentation) == 168, "serialize the new Segmentation field");
-static_assert(sizeof(WorldGate) == 36, "serialize the new WorldGate field");
-static_assert(sizeof(SceneTopology) == 368, "serialize the new SceneTopology field");
+static_assert(sizeof(Gate) == 48, "serialize the new Gate field");
+// Segmentation::pieces (24 bytes) is set-up only and deliberately not stored.
+static_assert(sizeof(Segmentation) == 192, "serialize the new Segmentation field");
+static_assert(sizeof(WorldGate) == 48, "serialize the new WorldGate field");
+static_assert(sizeof(SceneTopology) == 392, "serialize the new SceneTopology field");
 
 constexpr char kMagic[8] = {'G', 'I', 'L', 'A', 'B', 'T', 'O', 'P'};
 constexpr size_t kChecksumBytes = 16;
-constexpr size_t kGateBytes = 9 * 4;
+constexpr size_t kGateBytes = 12 * 4;
 constexpr bool kLittleEndianHost = std::endian::native == std::endian::little;
 
 /** A little-endian byte stream (the cache file, and the key's input). */
@@ -93,7 +96,10 @@ public:
         for (const G& g : v) {
             vec3(g.centre);
             vec3(g.normal);
+            f32(g.radiusNeck);
             f32(g.radius);
+            f32(g.radiusA);
+            f32(g.radiusB);
             u32(g.clusterA);
             u32(g.clusterB);
         }
@@ -197,7 +203,10 @@ public:
         for (G& g : v) {
             g.centre = vec3(what);
             g.normal = vec3(what);
+            g.radiusNeck = f32(what);
             g.radius = f32(what);
+            g.radiusA = f32(what);
+            g.radiusB = f32(what);
             g.clusterA = u32(what);
             g.clusterB = u32(what);
         }
@@ -241,13 +250,26 @@ void checkSize(size_t size, size_t expected, const std::string& what, const char
 }
 
 template <class G>
-void checkGateClusters(const std::vector<G>& gates, uint32_t clusterCount, const char* what) {
-    for (size_t i = 0; i < gates.size(); ++i)
-        if (gates[i].clusterA >= clusterCount || gates[i].clusterB >= clusterCount) {
+void checkGates(const std::vector<G>& gates, uint32_t clusterCount, const char* what) {
+    for (size_t i = 0; i < gates.size(); ++i) {
+        const G& g = gates[i];
+        if (g.clusterA >= clusterCount || g.clusterB >= clusterCount) {
             corrupt(std::string(what) + "[" + std::to_string(i) + "] joins clusters " +
-                    std::to_string(gates[i].clusterA) + " and " +
-                    std::to_string(gates[i].clusterB) + " of " + std::to_string(clusterCount));
+                    std::to_string(g.clusterA) + " and " + std::to_string(g.clusterB) + " of " +
+                    std::to_string(clusterCount));
         }
+        // radius is min(radiusA, radiusB) exactly (a world radius too: scaling by the voxel size
+        // is monotonic, so it commutes with min).
+        if (!(g.radiusA >= 0.0f) || !(g.radiusB >= 0.0f) || !std::isfinite(g.radiusA) ||
+            !std::isfinite(g.radiusB) || g.radius != std::min(g.radiusA, g.radiusB) ||
+            !(g.radiusNeck >= 0.0f) || !(g.radiusNeck <= g.radius)) {
+            corrupt(std::string(what) + "[" + std::to_string(i) + "] has radius " +
+                    std::to_string(g.radius) + ", end radii " + std::to_string(g.radiusA) +
+                    " and " + std::to_string(g.radiusB) + ", neck radius " +
+                    std::to_string(g.radiusNeck) +
+                    " (expected finite, >= 0, radius their minimum, the neck at most that)");
+        }
+    }
 }
 
 /** The invariants of buildSceneTopology that readers of a topology rely on (sizes that index
@@ -298,7 +320,12 @@ void checkConsistent(const SceneTopology& t) {
                 std::to_string(s.coverageNodes) + " coverage nodes differ from " +
                 std::to_string(s.kept.size()) + " kept");
     }
-    checkGateClusters(s.gates, s.clusterCount, "segmentation.gates");
+    if (s.greedyClusters < s.clusterCount) {
+        corrupt("segmentation.greedyClusters " + std::to_string(s.greedyClusters) +
+                " is below clusterCount " + std::to_string(s.clusterCount) +
+                " (the merge only removes clusters)");
+    }
+    checkGates(s.gates, s.clusterCount, "segmentation.gates");
     for (size_t i = 0; i < t.voxelCluster.size(); ++i)
         if (t.voxelCluster[i] != kNoNode && t.voxelCluster[i] >= s.clusterCount) {
             corrupt("voxelCluster[" + std::to_string(i) +
@@ -306,7 +333,7 @@ void checkConsistent(const SceneTopology& t) {
                     std::to_string(s.clusterCount) + " clusters)");
         }
     checkSize(t.gates.size(), s.gates.size(), "gates", "segmentation.gates");
-    checkGateClusters(t.gates, s.clusterCount, "gates");
+    checkGates(t.gates, s.clusterCount, "gates");
 }
 
 std::string serialize(const std::string& key, const SceneTopology& t) {
@@ -342,6 +369,7 @@ std::string serialize(const std::string& key, const SceneTopology& t) {
     w.lists(s.segmentedAdjacency);
     w.u32Array(s.cluster);
     w.u32(s.clusterCount);
+    w.u32(s.greedyClusters);
     w.gates(s.gates);
     w.u32(s.curvatureNodes);
     w.u32(s.coverageNodes);
@@ -403,6 +431,7 @@ SceneTopology deserialize(std::string_view data, const std::string& key) {
     s.segmentedAdjacency = r.lists("segmentation.segmentedAdjacency");
     s.cluster = r.u32Array("segmentation.cluster");
     s.clusterCount = r.u32("segmentation.clusterCount");
+    s.greedyClusters = r.u32("segmentation.greedyClusters");
     s.gates = r.gates<Gate>("segmentation.gates");
     s.curvatureNodes = r.u32("segmentation counts");
     s.coverageNodes = r.u32("segmentation counts");
@@ -437,6 +466,9 @@ std::string topologyKey(const Scene& scene, const TopologySettings& settings) {
     w.text("settings");
     w.u32(settings.resolution);
     w.f32(settings.alpha);
+    w.u8(settings.mergeVisible ? 1 : 0);
+    w.u8(uint8_t(settings.gatePlacement));
+    w.f32(settings.mergeVisibility);
     w.f32(VoxelGrid::kDefaultMargin);  // buildSceneTopology fits the grid with it
     w.text("bounds");
     w.vec3(scene.caps.bounds.lo);
