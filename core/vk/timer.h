@@ -38,6 +38,9 @@ public:
     const std::string& note() const { return m_note; }
 
 private:
+    /** Writes a timestamp into `query`, then one into the spare query (see timer.cpp). */
+    void stamp(VkCommandBuffer cmd, uint32_t query);
+
     struct Open {
         std::string name;
         uint32_t query;
