@@ -338,6 +338,43 @@ TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
     EXPECT_EQ(keys.size(), 2u);
 }
 
+// metrics.same_vpl_reference: a VPL technique's run also gets Table II (Noël & Biri 2014)
+// against its own VPLs with exact shadow rays; other techniques do not. With the door closed
+// the gates let nothing into room B, as the shadow rays: MSE 0; the unshadowed VPLs leak.
+TEST_F(GpuRunner, SameVplReferenceGivesTableIIForVplTechniques) {
+    nlohmann::json j = baseConfig();
+    j["name"] = "same_vpl";
+    j["scenes"] = {{{"scene", std::string(GILAB_SOURCE_DIR) +
+                                  "/scenes/stress/two_rooms_door.json#room_b_closed"},
+                    {"resolution", {32, 32}}}};
+    j["metrics"] = {{"same_vpl_reference", true}};
+    j["techniques"] = {
+        {{"technique", "direct"}},
+        {{"technique", "topovpl"},
+         {"params", {{"voxel_resolution", 64}, {"topology_cache", "off"}, {"vpls", 256}}}}};
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary s = runExperiment(options());
+    ASSERT_EQ(s.ran, 2u);
+    int vplRuns = 0;
+    for (const nlohmann::json& r : RunStore(s.dir).loadFinished()) {
+        ASSERT_EQ(r["status"], "ok");
+        const nlohmann::json& m = r["metrics"];
+        if (r["technique"]["id"] == "direct") {
+            EXPECT_FALSE(m.contains("same_vpl"));
+            continue;
+        }
+        ++vplRuns;
+        ASSERT_TRUE(m.contains("same_vpl"));
+        const nlohmann::json& t = m["same_vpl"]["table_ii"];
+        EXPECT_GT(m["same_vpl"]["vpls"].get<double>(), 0.0);
+        EXPECT_EQ(t["method"]["mse"].get<double>(), 0.0);
+        EXPECT_EQ(t["direct_only"]["mse"].get<double>(), 0.0);
+        EXPECT_GT(t["unshadowed"]["mse"].get<double>(), 0.0);
+        EXPECT_GT(t["unshadowed"]["mse_8bit"].get<double>(), 0.0);
+    }
+    EXPECT_EQ(vplRuns, 1);
+}
+
 TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {
     nlohmann::json j = baseConfig();
     j["name"] = "anim";

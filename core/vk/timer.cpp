@@ -18,13 +18,13 @@ GpuTimer::GpuTimer(Context& ctx, uint32_t maxPasses)
     }
     VkQueryPoolCreateInfo info{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
     info.queryType = VK_QUERY_TYPE_TIMESTAMP;
-    info.queryCount = 2 * maxPasses + 1;  // + the spare of stamp()
+    info.queryCount = 4 * maxPasses;  // begin, end, and a spare of each for stamp()
     VkQueryPool pool = VK_NULL_HANDLE;
     VK_CHECK(vkCreateQueryPool(ctx.device(), &info, nullptr, &pool));
     m_pool = QueryPoolHandle(ctx.device(), pool);
     ctx.setDebugName(VK_OBJECT_TYPE_QUERY_POOL, uint64_t(pool), "timer/queries");
     // Host reset so a resolve() before the first reset(cmd) reads "not available", not garbage.
-    vkResetQueryPool(ctx.device(), pool, 0, 2 * maxPasses + 1);
+    vkResetQueryPool(ctx.device(), pool, 0, 4 * maxPasses);
 }
 
 void GpuTimer::stamp(VkCommandBuffer cmd, uint32_t query) {
@@ -32,16 +32,17 @@ void GpuTimer::stamp(VkCommandBuffer cmd, uint32_t query) {
     // Lavapipe (Mesa 22.3) takes a timestamp's value at the next flush of its context, and only
     // a later timestamp write or a command that reads GPU memory on the host (an indirect
     // dispatch, a draw) flushes: a compute dispatch between two stamps was counted in neither.
-    // A second write to a spare query flushes right after this one. Measured: topovpl's
-    // indirect-lighting dispatch (480 ms alone) read 0.2 ms without it. Harmless elsewhere.
+    // A second write to a spare query (one per query: each is written once between resets)
+    // flushes right after this one. Measured: topovpl's indirect-lighting dispatch (480 ms
+    // alone) read 0.2 ms without it. Harmless elsewhere.
     vkCmdWriteTimestamp2(cmd, VK_PIPELINE_STAGE_2_ALL_COMMANDS_BIT, m_pool.handle(),
-                         2 * m_maxPasses);
+                         2 * m_maxPasses + query);
 }
 
 void GpuTimer::reset(VkCommandBuffer cmd) {
     m_passes.clear();
     m_stack.clear();
-    if (m_supported) vkCmdResetQueryPool(cmd, m_pool.handle(), 0, 2 * m_maxPasses + 1);
+    if (m_supported) vkCmdResetQueryPool(cmd, m_pool.handle(), 0, 4 * m_maxPasses);
 }
 
 void GpuTimer::begin(VkCommandBuffer cmd, const std::string& name) {
