@@ -91,7 +91,8 @@ glm::vec3 clusterColour(uint32_t c) {
     return 0.2f + 0.8f * rgb[sector % 6];
 }
 
-void exportTopologyGltf(const SceneTopology& t, const std::string& path) {
+void exportTopologyGltf(const SceneTopology& t, const std::string& path,
+                        const std::vector<float>& gateRadii) {
     const Segmentation& s = t.segmentation;
     auto world = [&](uint32_t node) { return t.grid.gridToWorld(t.graph.position[node] + 0.5f); };
     Primitive lines, points, disks;
@@ -108,7 +109,9 @@ void exportTopologyGltf(const SceneTopology& t, const std::string& path) {
         }
     }
     constexpr int kSegments = 24;
-    for (const WorldGate& g : t.gates) {
+    for (size_t i = 0; i < t.gates.size(); ++i) {
+        const WorldGate& g = t.gates[i];
+        const float radius = i < gateRadii.size() ? gateRadii[i] : g.radius;
         const glm::vec3 n = glm::normalize(g.normal);
         const glm::vec3 u = glm::normalize(
             glm::cross(n, std::abs(n.y) < 0.9f ? glm::vec3(0, 1, 0) : glm::vec3(1, 0, 0)));
@@ -117,8 +120,7 @@ void exportTopologyGltf(const SceneTopology& t, const std::string& path) {
         disks.positions.push_back(g.centre);
         for (int k = 0; k < kSegments; ++k) {
             const float phi = 6.2831853f * float(k) / kSegments;
-            disks.positions.push_back(g.centre +
-                                      g.radius * (std::cos(phi) * u + std::sin(phi) * w));
+            disks.positions.push_back(g.centre + radius * (std::cos(phi) * u + std::sin(phi) * w));
         }
         disks.colours.insert(disks.colours.end(), kSegments + 1, clusterColour(g.clusterA));
         for (int k = 0; k < kSegments; ++k)

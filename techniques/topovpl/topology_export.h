@@ -9,6 +9,7 @@
  * World units, the scene's own frame. Throws gilab::Error naming the file when it cannot write.
  */
 #include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -19,6 +20,9 @@ struct SceneTopology;
 /** A stable colour for cluster c (shared by the export and the debug view). */
 glm::vec3 clusterColour(uint32_t c);
 
-void exportTopologyGltf(const SceneTopology& topology, const std::string& path);
+/** gateRadii: the disks' radii, one per gate (the per-frame gate-radius rule); empty: each
+ *  gate's `radius` (E4's min of the two end balls). */
+void exportTopologyGltf(const SceneTopology& topology, const std::string& path,
+                        const std::vector<float>& gateRadii = {});
 
 }  // namespace gilab::topo

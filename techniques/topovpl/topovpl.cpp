@@ -18,6 +18,7 @@
 #include "techniques/topovpl/pixel_clusters.h"
 #include "techniques/topovpl/scene_topology.h"
 #include "techniques/topovpl/topology_cache.h"
+#include "techniques/topovpl/topology_export.h"
 
 namespace gilab {
 namespace {
@@ -163,6 +164,17 @@ void TopovplTechnique::setup(TechniqueContext& ctx) {
                                              s.vpls, gateTable(t, s), capacity, ctx.tag("gi"));
     m_gpu = std::move(gpu);
     applySettings(ctx);
+    if (s.useCache) {
+        // The debug glTF (skeleton, kept nodes, gate disks at this run's radius rule) next to
+        // the cache entry, for any glTF viewer.
+        std::vector<float> radii;
+        for (const topo::WorldGate& g : t.gates)
+            radii.push_back(gateRadius(g, s));
+        const auto gltf = topo::defaultTopologyCacheDir() /
+                          (topo::topologyKey(ctx.scene, topologySettings(s)) + ".gltf");
+        topo::exportTopologyGltf(t, gltf.string(), radii);
+        ctx.note("topology debug glTF (skeleton, nodes, gates by cluster): " + gltf.string());
+    }
 
     const Light& l = ctx.scene.lights[size_t(light)];
     ctx.note("main light " + std::to_string(light) + " ('" + l.name + "', " +
