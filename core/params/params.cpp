@@ -153,14 +153,15 @@ std::string checkSpec(const ParamSpec& spec) {
 }  // namespace
 
 ParamSet::ParamSet(std::vector<ParamSpec> specs, std::string owner)
-    : m_specs(std::move(specs)), m_owner(std::move(owner)) {
-    for (size_t i = 0; i < m_specs.size(); ++i) {
-        const ParamSpec& spec = m_specs[i];
+    : m_specs(std::make_shared<const std::vector<ParamSpec>>(std::move(specs))),
+      m_owner(std::move(owner)) {
+    for (size_t i = 0; i < table().size(); ++i) {
+        const ParamSpec& spec = table()[i];
         const std::string what = prefix() + "parameter spec " + inQuotes(spec.name) + " ";
         if (std::string why = checkSpec(spec); !why.empty())
             throw Error(what + "is invalid: " + why);
         for (size_t j = 0; j < i; ++j) {
-            if (m_specs[j].name == spec.name) throw Error(what + "is declared twice");
+            if (table()[j].name == spec.name) throw Error(what + "is declared twice");
         }
         Parsed parsed = parseValue(spec, spec.defaultValue);
         if (!parsed.value) throw Error(what + "is invalid: default value " + parsed.reason);
@@ -173,8 +174,8 @@ std::string ParamSet::prefix() const {
 }
 
 int ParamSet::findIndex(const std::string& key) const {
-    for (size_t i = 0; i < m_specs.size(); ++i) {
-        if (m_specs[i].name == key) return int(i);
+    for (size_t i = 0; i < table().size(); ++i) {
+        if (table()[i].name == key) return int(i);
     }
     return -1;
 }
@@ -182,10 +183,10 @@ int ParamSet::findIndex(const std::string& key) const {
 size_t ParamSet::requireKnownKey(const std::string& key) const {
     const int index = findIndex(key);
     if (index >= 0) return size_t(index);
-    if (m_specs.empty())
+    if (table().empty())
         throw Error(prefix() + "unknown parameter " + inQuotes(key) + "; there are no parameters");
     std::vector<std::string> names;
-    for (const ParamSpec& spec : m_specs)
+    for (const ParamSpec& spec : table())
         names.push_back(spec.name);
     std::string message = prefix() + "unknown parameter " + inQuotes(key);
     std::string closest = findClosestMatch(key, names);
@@ -198,8 +199,8 @@ const ParamSet::Value& ParamSet::requireTyped(const std::string& key, ParamType 
     const int index = findIndex(key);
     const std::string call = prefix() + getter + "(" + inQuotes(key) + "): ";
     if (index < 0) throw Error(call + "no such parameter (programming error)");
-    if (m_specs[size_t(index)].type != type) {
-        throw Error(call + "parameter is " + paramTypeName(m_specs[size_t(index)].type) + ", not " +
+    if (table()[size_t(index)].type != type) {
+        throw Error(call + "parameter is " + paramTypeName(table()[size_t(index)].type) + ", not " +
                     paramTypeName(type) + " (programming error)");
     }
     return m_values[size_t(index)];
@@ -207,7 +208,7 @@ const ParamSet::Value& ParamSet::requireTyped(const std::string& key, ParamType 
 
 void ParamSet::set(const std::string& key, const std::string& text) {
     const size_t index = requireKnownKey(key);
-    Parsed parsed = parseValue(m_specs[index], text);
+    Parsed parsed = parseValue(table()[index], text);
     if (!parsed.value) throw Error(prefix() + "parameter " + inQuotes(key) + " " + parsed.reason);
     m_values[index] = std::move(*parsed.value);
 }
@@ -217,7 +218,7 @@ void ParamSet::setJson(const std::string& key, const nlohmann::json& value) {
     // Scalars go through the text rules, so JSON and command line accept exactly the same.
     if (value.is_string()) return set(key, value.get<std::string>());
     if (value.is_boolean() || value.is_number()) return set(key, value.dump());
-    const ParamSpec& spec = m_specs[index];
+    const ParamSpec& spec = table()[index];
     const std::string expected = spec.type == ParamType::Bool    ? "a boolean"
                                  : spec.type == ParamType::Int   ? "an integer"
                                  : spec.type == ParamType::Float ? "a number"
@@ -263,7 +264,7 @@ std::string ParamSet::getText(const std::string& key) const {
 }
 
 const ParamSpec& ParamSet::spec(const std::string& key) const {
-    return m_specs[requireKnownKey(key)];
+    return table()[requireKnownKey(key)];
 }
 
 nlohmann::json ParamSet::toJson() const {
@@ -272,28 +273,28 @@ nlohmann::json ParamSet::toJson() const {
 
 nlohmann::ordered_json ParamSet::toOrderedJson() const {
     nlohmann::ordered_json out = nlohmann::ordered_json::object();
-    for (size_t i = 0; i < m_specs.size(); ++i) {
-        std::visit([&](const auto& v) { out[m_specs[i].name] = v; }, m_values[i]);
+    for (size_t i = 0; i < table().size(); ++i) {
+        std::visit([&](const auto& v) { out[table()[i].name] = v; }, m_values[i]);
     }
     return out;
 }
 
 std::string ParamSet::toString() const {
     std::string out;
-    for (size_t i = 0; i < m_specs.size(); ++i) {
+    for (size_t i = 0; i < table().size(); ++i) {
         if (i > 0) out += ' ';
-        out += m_specs[i].name + "=" + canonicalText(m_values[i]);
+        out += table()[i].name + "=" + canonicalText(m_values[i]);
     }
     return out;
 }
 
 std::vector<std::string> ParamSet::changedKeys(const ParamSet& other) const {
     std::vector<std::string> keys;
-    for (size_t i = 0; i < m_specs.size(); ++i) {
-        const int j = other.findIndex(m_specs[i].name);
-        if (j < 0 || other.m_values[size_t(j)] != m_values[i]) keys.push_back(m_specs[i].name);
+    for (size_t i = 0; i < table().size(); ++i) {
+        const int j = other.findIndex(table()[i].name);
+        if (j < 0 || other.m_values[size_t(j)] != m_values[i]) keys.push_back(table()[i].name);
     }
-    for (const ParamSpec& spec : other.m_specs) {
+    for (const ParamSpec& spec : other.table()) {
         if (findIndex(spec.name) < 0) keys.push_back(spec.name);
     }
     return keys;
@@ -302,7 +303,7 @@ std::vector<std::string> ParamSet::changedKeys(const ParamSet& other) const {
 bool ParamSet::changesNeedRebuild(const std::vector<std::string>& keys) const {
     for (const std::string& key : keys) {
         const int index = findIndex(key);
-        if (index < 0 || m_specs[size_t(index)].stage == ParamStage::Rebuild) return true;
+        if (index < 0 || table()[size_t(index)].stage == ParamStage::Rebuild) return true;
     }
     return false;
 }

@@ -13,6 +13,7 @@
  * Surrounding whitespace is ignored. Every error is a gilab::Error naming the owner and key.
  */
 #include <limits>
+#include <memory>
 #include <string>
 #include <utility>
 #include <variant>
@@ -75,7 +76,7 @@ public:
 
     bool has(const std::string& key) const { return findIndex(key) >= 0; }
     const std::string& owner() const { return m_owner; }
-    const std::vector<ParamSpec>& specs() const { return m_specs; }
+    const std::vector<ParamSpec>& specs() const { return table(); }
     const ParamSpec& spec(const std::string& key) const;
 
     /** {key: typed value}. nlohmann::json sorts keys; toOrderedJson keeps spec order. */
@@ -96,7 +97,14 @@ private:
     const Value& requireTyped(const std::string& key, ParamType type, const char* getter) const;
     std::string prefix() const;
 
-    std::vector<ParamSpec> m_specs;
+    /** The specs (a default-constructed or moved-from set has none). */
+    const std::vector<ParamSpec>& table() const {
+        static const std::vector<ParamSpec> kNone;
+        return m_specs ? *m_specs : kNone;
+    }
+
+    // Immutable and shared by every copy: an experiment plans 100k runs, each with a copy.
+    std::shared_ptr<const std::vector<ParamSpec>> m_specs;
     std::vector<Value> m_values;  // parallel to m_specs
     std::string m_owner;
 };

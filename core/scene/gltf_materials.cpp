@@ -1,4 +1,5 @@
 // glTF materials and textures -> gilab::Material / gilab::Texture.
+#include <cmath>
 #include <filesystem>
 #include <sstream>
 
@@ -53,6 +54,36 @@ std::vector<uint8_t> toRgba8(const tinygltf::Image& image) {
     return rgba;
 }
 
+std::string num(double v) {
+    std::ostringstream out;
+    out.precision(9);
+    out << v;
+    return out.str();
+}
+
+/**
+ * Factors must be finite and in [lo, hi] (docs/conventions.md, "Invalid physical inputs"):
+ * a negative albedo or emission would put negative pixels into every output.
+ */
+void checkFactor(double value, double lo, double hi, const std::string& what,
+                 const std::string& key) {
+    if (!(std::isfinite(float(value)) && value >= lo && value <= hi)) {
+        throw Error(what + ": invalid " + key + " " + num(value) +
+                    (std::isinf(hi) ? " (must be finite and >= " + num(lo) + ")"
+                                    : " (must be in [" + num(lo) + ", " + num(hi) + "])"));
+    }
+}
+
+void checkFactors(const std::vector<double>& values, size_t size, double lo, double hi,
+                  const std::string& what, const std::string& key) {
+    if (values.size() != size) {
+        throw Error(what + ": " + key + " has " + std::to_string(values.size()) + " numbers (" +
+                    std::to_string(size) + " required)");
+    }
+    for (size_t i = 0; i < size; ++i)
+        checkFactor(values[i], lo, hi, what, key + "[" + std::to_string(i) + "]");
+}
+
 }  // namespace
 
 void MaterialConverter::convertAll() {
@@ -63,10 +94,19 @@ void MaterialConverter::convertAll() {
         Material mat;
         mat.name = src.name.empty() ? "material_" + std::to_string(i) : src.name;
         const std::string label = "material '" + mat.name + "'";
-        if (pbr.baseColorFactor.size() == 4) {
-            mat.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
-                                            pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
+        const std::string what = m_file + ": material " + std::to_string(i) +
+                                 (src.name.empty() ? "" : " '" + src.name + "'");
+        checkFactors(pbr.baseColorFactor, 4, 0.0, 1.0, what, "baseColorFactor");
+        checkFactor(pbr.metallicFactor, 0.0, 1.0, what, "metallicFactor");
+        checkFactor(pbr.roughnessFactor, 0.0, 1.0, what, "roughnessFactor");
+        checkFactors(src.emissiveFactor, 3, 0.0, 1.0, what, "emissiveFactor");
+        checkFactor(src.alphaCutoff, 0.0, HUGE_VAL, what, "alphaCutoff");
+        if (src.alphaMode != "OPAQUE" && src.alphaMode != "MASK" && src.alphaMode != "BLEND") {
+            throw Error(what + ": unknown alphaMode '" + src.alphaMode +
+                        "' (OPAQUE, MASK or BLEND)");
         }
+        mat.baseColorFactor = glm::vec4(pbr.baseColorFactor[0], pbr.baseColorFactor[1],
+                                        pbr.baseColorFactor[2], pbr.baseColorFactor[3]);
         mat.metallic = float(pbr.metallicFactor);
         mat.roughness = float(pbr.roughnessFactor);
         mat.baseColorTexture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
@@ -79,12 +119,18 @@ void MaterialConverter::convertAll() {
         float strength = 1.0f;
         auto ext = src.extensions.find("KHR_materials_emissive_strength");
         if (ext != src.extensions.end() && ext->second.Has("emissiveStrength")) {
-            strength = float(ext->second.Get("emissiveStrength").GetNumberAsDouble());
+            const tinygltf::Value& v = ext->second.Get("emissiveStrength");
+            if (!v.IsNumber()) {
+                throw Error(what + ": KHR_materials_emissive_strength.emissiveStrength is not a " +
+                            "number");
+            }
+            const double value = v.GetNumberAsDouble();
+            checkFactor(value, 0.0, HUGE_VAL, what,
+                        "KHR_materials_emissive_strength.emissiveStrength");
+            strength = float(value);
         }
-        if (src.emissiveFactor.size() == 3) {
-            mat.emissiveFactor = strength * glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1],
-                                                      src.emissiveFactor[2]);
-        }
+        mat.emissiveFactor = strength * glm::vec3(src.emissiveFactor[0], src.emissiveFactor[1],
+                                                  src.emissiveFactor[2]);
         mat.emissiveTexture = texture(src.emissiveTexture.index, src.emissiveTexture.texCoord,
                                       ColorSpace::Srgb, label);
 
@@ -121,22 +167,34 @@ uint32_t MaterialConverter::defaultMaterial() {
 
 int MaterialConverter::texture(int gltfTexture, int texCoord, ColorSpace space,
                                const std::string& material) {
-    if (gltfTexture < 0) return -1;
+    if (gltfTexture == -1) return -1;  // tinygltf's "absent"
     if (texCoord != 0) {
         m_scene.warnings.push_back(m_file + ": " + material + " uses TEXCOORD_" +
                                    std::to_string(texCoord) + "; TEXCOORD_0 is used instead");
     }
-    if (size_t(gltfTexture) >= m_model.textures.size()) {
+    if (gltfTexture < 0 || size_t(gltfTexture) >= m_model.textures.size()) {
         throw Error(m_file + ": " + material + " references missing texture " +
-                    std::to_string(gltfTexture));
+                    std::to_string(gltfTexture) + " (the file has " +
+                    std::to_string(m_model.textures.size()) + " textures)");
     }
     const tinygltf::Texture& tex = m_model.textures[size_t(gltfTexture)];
-    if (tex.source < 0 || size_t(tex.source) >= m_model.images.size()) {
+    if (tex.source == -1) {
         throw Error(m_file + ": texture " + std::to_string(gltfTexture) +
                     " has no image source (extension-only sources are unsupported)");
     }
+    if (tex.source < 0 || size_t(tex.source) >= m_model.images.size()) {
+        throw Error(m_file + ": texture " + std::to_string(gltfTexture) + " references image " +
+                    std::to_string(tex.source) + ", which does not exist (the file has " +
+                    std::to_string(m_model.images.size()) + " images)");
+    }
     tinygltf::Sampler sampler;  // defaults: repeat
-    if (tex.sampler >= 0 && size_t(tex.sampler) < m_model.samplers.size()) {
+    if (tex.sampler != -1) {
+        if (tex.sampler < 0 || size_t(tex.sampler) >= m_model.samplers.size()) {
+            throw Error(m_file + ": texture " + std::to_string(gltfTexture) +
+                        " references sampler " + std::to_string(tex.sampler) +
+                        ", which does not exist (the file has " +
+                        std::to_string(m_model.samplers.size()) + " samplers)");
+        }
         sampler = m_model.samplers[size_t(tex.sampler)];
     }
     // Textures sharing an image and wrap modes share one decoded copy.
@@ -156,6 +214,17 @@ int MaterialConverter::texture(int gltfTexture, int texCoord, ColorSpace space,
         }
         throw Error(m_file + ": image " + std::to_string(tex.source) + " '" + image.uri +
                     image.name + "' could not be decoded");
+    }
+
+    // The decoded pixels must hold width x height x component samples of `bits`
+    const size_t samples = size_t(image.width) * size_t(image.height) * size_t(image.component);
+    if (image.component < 1 || image.component > 4 || (image.bits != 8 && image.bits != 16) ||
+        image.image.size() < samples * size_t(image.bits / 8)) {
+        throw Error(m_file + ": image " + std::to_string(tex.source) + " '" + image.uri +
+                    image.name + "' has an inconsistent decoded size (" +
+                    std::to_string(image.width) + "x" + std::to_string(image.height) + ", " +
+                    std::to_string(image.component) + " channels, " + std::to_string(image.bits) +
+                    " bits, " + std::to_string(image.image.size()) + " bytes)");
     }
 
     Texture out;

@@ -76,6 +76,17 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
                     std::to_string(n) + " vertices)");
     }
 
+    if (n > kMaxSceneVertices - std::min(scene.vertices.size(), kMaxSceneVertices)) {
+        throw Error(what + ": " + std::to_string(n) + " more vertices would exceed the limit of " +
+                    std::to_string(kMaxSceneVertices) + " vertices per scene (the scene has " +
+                    std::to_string(scene.vertices.size()) + ")");
+    }
+    for (int c = 0; c < 4; ++c) {
+        if (!std::isfinite(toWorld[c].x + toWorld[c].y + toWorld[c].z + toWorld[c].w)) {
+            throw Error(what + ": the node's world transform is not finite");
+        }
+    }
+
     // Transform to world space
     const glm::mat3 linear(toWorld);
     const bool flip = glm::determinant(linear) < 0.0f;
@@ -83,6 +94,12 @@ void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& t
     std::vector<glm::vec3> positions(n);
     for (size_t i = 0; i < n; ++i)
         positions[i] = glm::vec3(toWorld * glm::vec4(prim.positions[i], 1.0f));
+    const size_t overflowed = size_t(std::count_if(positions.begin(), positions.end(),
+                                                   [](const glm::vec3& p) { return !finite(p); }));
+    if (overflowed > 0) {
+        throw Error(what + ": " + std::to_string(overflowed) + " of " + std::to_string(n) +
+                    " POSITION values overflow a float in world space (node transform too large)");
+    }
 
     // Keep non-degenerate triangles, accumulating area-weighted normals as we go
     std::vector<uint32_t> kept;

@@ -29,10 +29,16 @@ struct MeshStats {
     size_t recomputedNormals = 0;    // zero-length normals in the file, rebuilt from faces
 };
 
+/** Most vertices one scene may hold (32-bit indices; about 8.6 GB of vertices). */
+constexpr size_t kMaxSceneVertices = size_t(1) << 28;
+
 /**
  * Validates `prim` (finite attributes, matching counts, indices in range; errors name `what`),
  * transforms it by `toWorld` (normals by the inverse transpose; winding flipped when the
- * determinant is negative), drops degenerate triangles and appends it with `material`.
+ * determinant is negative), drops degenerate triangles (a repeated index or zero area, counted
+ * in `stats`, so nothing downstream divides by a zero area) and appends it with `material`.
+ * A non-finite transform or world position, or more than kMaxSceneVertices vertices in the
+ * scene, is an error.
  */
 void appendPrimitive(Scene& scene, const PrimitiveData& prim, const glm::mat4& toWorld,
                      uint32_t material, const std::string& what, MeshStats& stats);

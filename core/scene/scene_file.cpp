@@ -2,9 +2,7 @@
 #include <cctype>
 #include <cmath>
 #include <filesystem>
-#include <fstream>
 #include <map>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -23,15 +21,8 @@ namespace fs = std::filesystem;
 nlohmann::json readJson(const std::string& path) {
     std::error_code ec;
     if (!fs::is_regular_file(path, ec)) throw Error(path + ": scene file not found");
-    std::ifstream in(path);
-    std::stringstream text;
-    text << in.rdbuf();
-    if (!in) throw Error(path + ": cannot read scene file");
-    try {
-        return nlohmann::json::parse(text.str());
-    } catch (const nlohmann::json::parse_error& e) {
-        throw Error(path + ": malformed JSON: " + e.what());
-    }
+    // Duplicate keys, out-of-range numbers and syntax errors name the file, line and key
+    return readJsonFile(path, "scene file");
 }
 
 void applyMaterials(Scene& scene, const SceneDescription& d) {

@@ -5,6 +5,10 @@
  * Every value carries the file it came from and its key path ("lights[0].color"), so each
  * error names both: `scenes/x.json: "lights[0].intensity": must be >= 0 (got -1)`. Objects list
  * the keys they accept (`expectKeys`); anything else is an `unknown key` error.
+ *
+ * Files are read with `readJsonFile` / `parseJsonText`, which are stricter than nlohmann's
+ * parser: a duplicate key, a number beyond the range of a double (`1e999`) and malformed text
+ * are all gilab::Error naming the file, the line and column, and the key path.
  */
 #include <cstddef>
 #include <initializer_list>
@@ -56,6 +60,17 @@ private:
     std::string m_context;
     std::string m_path;
 };
+
+/**
+ * Parses JSON text. Errors (gilab::Error) start with `context` (the file name) and name the line
+ * and column and, where known, the key path: `x.json:3:17: "lights[0].intensity": number out of
+ * range (1e999 does not fit a double)`, `x.json:5:3: duplicate key "camera.position"`.
+ */
+nlohmann::json parseJsonText(const std::string& text, const std::string& context);
+
+/** Reads and parses a JSON file; `what` names it in messages ("scene file", "experiment
+ *  config"): `x.json: cannot open scene file`. */
+nlohmann::json readJsonFile(const std::string& path, const std::string& what);
 
 /** Optional-key helpers: return `fallback` when the key is absent. */
 double numberOr(const JsonNode& obj, const char* key, double fallback);

@@ -99,7 +99,7 @@ struct ReferenceOptions {
     std::string longReference;  // EXR of a longer run: adds the MSE-vs-samples curve
     bool quiet = false;
     std::string commandLine;
-    /** Cancel flag (tests); null = Ctrl-C (SIGINT) cancels, a second Ctrl-C kills. */
+    /** Cancel flag (tests); null = Ctrl-C (SIGINT) or SIGTERM cancels, a second one kills. */
     const std::atomic<bool>* cancel = nullptr;
 };
 int runReference(const ReferenceOptions& options);

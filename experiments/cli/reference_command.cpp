@@ -119,12 +119,12 @@ int renderReference(const ReferenceOptions& options, const Scene& scene,
     } else {
         interrupt.emplace(
             "\ngilab: interrupted: finishing at the next batch and saving a partial result "
-            "(Ctrl-C again to abort)\n");
+            "(a second Ctrl-C or SIGTERM aborts)\n");
         obtain.cancel = &interrupt->flag();
     }
     const ref::ReferenceResult r =
         ref::obtainReference(scene, settings, stop, cache ? &*cache : nullptr, obtain);
-    interrupt.reset();  // from here on, Ctrl-C kills as usual
+    interrupt.reset();  // from here on, Ctrl-C and SIGTERM kill as usual
     for (const std::string& w : r.warnings)
         std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
 
@@ -253,15 +253,29 @@ int runReference(const ReferenceOptions& options) {
         throw UsageError("--frames: " + scene.name + " has no animation (docs/scenes.md)");
     // One reference per selected frame, each cached under its own key (the frame's lights
     // and camera are part of it): re-running renders only what is missing.
+    // One interrupt scope for every frame, so a signal between two frames also stops cleanly
+    std::optional<InterruptScope> interrupt;
+    ReferenceOptions frameOptions = options;
+    if (!frameOptions.cancel) {
+        interrupt.emplace(
+            "\ngilab: interrupted: finishing at the next batch and saving a partial result "
+            "(a second Ctrl-C or SIGTERM aborts)\n");
+        frameOptions.cancel = &interrupt->flag();
+    }
     int worst = kExitOk;
     for (int f : parseFrameSelection(options.frames, scene.animation.frameCount)) {
+        if (frameOptions.cancel->load()) {
+            std::fprintf(stderr, "gilab: interrupted before frame %d; earlier frames are kept\n",
+                         f);
+            return kExitInterrupted;
+        }
         Scene frameScene = scene;
         applyFrameState(frameScene, frameState(scene, f));
         char dir[32];
         std::snprintf(dir, sizeof dir, "frame_%03d", f);
         std::printf("frame %d of %d (t = %.3f s):\n", f, scene.animation.frameCount,
                     scene.animation.frameTime(f));
-        const int code = renderReference(options, frameScene,
+        const int code = renderReference(frameOptions, frameScene,
                                          (std::filesystem::path(options.outDir) / dir).string());
         if (code == kExitInterrupted) return code;
         worst = std::max(worst, code);

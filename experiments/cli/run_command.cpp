@@ -23,7 +23,7 @@ int runExitCode(const exp::RunnerSummary& s, bool interrupted) {
 int runExperimentCommand(const exp::RunnerOptions& options) {
     InterruptScope interrupt(
         "\ngilab: interrupted: stopping after the current run; finished runs are kept "
-        "(Ctrl-C again to abort)\n");
+        "(a second Ctrl-C or SIGTERM aborts)\n");
     const exp::RunnerSummary s = exp::runExperiment(options, &interrupt.flag());
     if (options.dryRun) return kExitOk;
     std::printf(

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <set>
 
 #include "core/passes/shared_passes.h"
@@ -309,13 +310,20 @@ ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::st
                                        const std::string& baseDir) {
     const JsonNode root(json, context);
     root.expectKeys({"name", "description", "scenes", "resolution", "reference", "timing",
-                     "metrics", "shared", "techniques"});
+                     "metrics", "shared", "techniques", "max_runs"});
     ExperimentConfig c;
     c.path = context;
     c.name = root["name"].string();
+    // The name is the results folder under the output root: no "", ".", ".." or separators
+    if (c.name.empty())
+        root["name"].fail(
+            "empty name (it names the results folder; empty would put the runs "
+            "in the output root itself)");
     for (char ch : c.name)
         if (!(std::isalnum(static_cast<unsigned char>(ch)) || ch == '_' || ch == '-'))
-            root["name"].fail("use letters, digits, '_' and '-' only (it names a folder)");
+            root["name"].fail("\"" + c.name +
+                              "\": use letters, digits, '_' and '-' only (it names a folder)");
+    if (root.has("max_runs")) c.maxRuns = size_t(root["max_runs"].integerIn(1, kMaxRunsCeiling));
     if (root.has("description")) c.description = root["description"].string();
     int w = 0, h = 0;
     if (root.has("resolution")) {
@@ -346,25 +354,63 @@ ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::st
     if (techniques.arraySize() == 0) techniques.fail("needs at least one technique");
     for (size_t i = 0; i < techniques.arraySize(); ++i)
         c.techniques.push_back(parseTechnique(techniques.item(i), labels));
-    expandRuns(c);  // validates every combination (shared limits included) before anything runs
+    checkRunCount(c);  // before anything is expanded: a sweep may be astronomically large
+    expandRuns(c);     // validates every combination (shared limits included) before anything runs
     return c;
 }
 
 ExperimentConfig loadExperimentConfig(const std::string& path) {
-    std::ifstream in(path);
-    if (!in) throw Error(path + ": cannot open experiment config");
-    nlohmann::json json;
-    try {
-        json = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& e) {
-        throw Error(path + ": malformed JSON: " + e.what());
-    }
+    // Duplicate keys, out-of-range numbers and syntax errors name the file, line and key
+    const nlohmann::json json = readJsonFile(path, "experiment config");
     const std::string baseDir = fs::path(path).parent_path().string();
     return parseExperimentConfig(json, path, baseDir.empty() ? "." : baseDir);
 }
 
+size_t countRuns(const ExperimentConfig& config, size_t saturateAt) {
+    // Saturating arithmetic: the product of many sweep axes overflows size_t easily
+    const auto mul = [saturateAt](size_t a, size_t b) {
+        size_t r = 0;
+        return __builtin_mul_overflow(a, b, &r) || r > saturateAt ? saturateAt : r;
+    };
+    const auto add = [saturateAt](size_t a, size_t b) {
+        size_t r = 0;
+        return __builtin_add_overflow(a, b, &r) || r > saturateAt ? saturateAt : r;
+    };
+    size_t total = 0;
+    for (const SceneEntry& scene : config.scenes)
+        for (const TechniqueEntry& t : config.techniques) {
+            if (!t.scenes.empty() &&
+                std::find(t.scenes.begin(), t.scenes.end(), scene.label) == t.scenes.end())
+                continue;
+            size_t n = 1;
+            for (const auto& [key, values] : t.grid)
+                n = mul(n, values.size());
+            if (!t.zip.empty()) n = mul(n, t.zip.front().second.size());
+            total = add(total, n);
+        }
+    return total;
+}
+
+void checkRunCount(const ExperimentConfig& config) {
+    const size_t limit = config.maxRuns;
+    const size_t count = countRuns(config, std::numeric_limits<size_t>::max());
+    if (count <= limit) return;
+    const std::string countText = count == std::numeric_limits<size_t>::max()
+                                      ? "more than " + std::to_string(count)
+                                      : std::to_string(count);
+    throw Error(config.path + ": the sweeps expand to " + countText +
+                " runs (scenes x techniques x sweep points), more than the limit of " +
+                std::to_string(limit) +
+                "; shrink the sweeps, or raise the limit with \"max_runs\": " +
+                (count <= kMaxRunsCeiling ? std::to_string(count)
+                                          : "N (at most " + std::to_string(kMaxRunsCeiling) + ")") +
+                " at the top level of the config (docs/experiments.md)");
+}
+
 std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
+    checkRunCount(config);  // also for configs built in memory
     std::vector<RunSpec> runs;
+    runs.reserve(countRuns(config, config.maxRuns));
     for (const SceneEntry& scene : config.scenes) {
         for (const TechniqueEntry& t : config.techniques) {
             if (!t.scenes.empty() &&

@@ -66,6 +66,11 @@ struct TechniqueEntry {
     std::vector<std::string> scenes;  // scene labels this block runs on; empty = every scene
 };
 
+/** Default of "max_runs": a config whose sweeps expand to more runs is refused. */
+inline constexpr size_t kDefaultMaxRuns = 100000;
+/** The largest "max_runs" a config may set (planning costs memory per run). */
+inline constexpr int kMaxRunsCeiling = 100000000;
+
 struct ExperimentConfig {
     std::string name;
     std::string path;
@@ -76,6 +81,7 @@ struct ExperimentConfig {
     MetricOptionsSpec metrics;
     std::map<std::string, nlohmann::json> shared;  // shared-pass parameters for every run
     std::vector<TechniqueEntry> techniques;
+    size_t maxRuns = kDefaultMaxRuns;  // "max_runs"
 };
 
 ExperimentConfig loadExperimentConfig(const std::string& path);
@@ -93,8 +99,14 @@ struct RunSpec {
     std::map<std::string, std::string> swept;  // swept key -> canonical value text
 };
 
-/** Expands every technique block into runs (scenes outermost), validating every value. */
+/** Expands every technique block into runs (scenes outermost), validating every value.
+ *  Throws (checkRunCount) before expanding anything if there would be more than maxRuns. */
 std::vector<RunSpec> expandRuns(const ExperimentConfig& config);
+
+/** The number of runs expandRuns would make, without expanding (capped at `saturateAt`). */
+size_t countRuns(const ExperimentConfig& config, size_t saturateAt);
+/** Throws gilab::Error naming the count and "max_runs" if the sweeps exceed config.maxRuns. */
+void checkRunCount(const ExperimentConfig& config);
 
 /** The metric options as JSON (part of every run's identity). */
 nlohmann::ordered_json metricsSpecJson(const MetricOptionsSpec& spec);

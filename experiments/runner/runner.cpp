@@ -17,6 +17,7 @@
 #include "core/util/build_info.h"
 #include "core/util/error.h"
 #include "core/util/hash.h"
+#include "core/util/json_reader.h"
 #include "core/util/progress.h"
 #include "core/vk/context.h"
 #include "experiments/cli/run_metadata.h"
@@ -116,6 +117,10 @@ struct Context {
     std::string configHash;
 };
 
+/** SIGINT or SIGTERM during a reference: the partial reference is cached, the run is dropped
+ *  (not committed) and the experiment stops like at a run boundary. */
+struct ReferenceInterrupted {};
+
 /** The reference of `scene` (frame `frame` of an animated entry; -1 = the static scene). */
 const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene,
                                  int frame = -1) {
@@ -131,6 +136,7 @@ const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scen
                                                   c.config.reference.stop, c.cache, opts);
     for (const std::string& w : r.warnings)
         std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
+    if (r.reason == ref::StopReason::Cancelled) throw ReferenceInterrupted{};  // partial: cached
     if (!r.complete)
         throw Error("reference for " + id + " was interrupted (" + ref::stopReasonName(r.reason) +
                     "); runs need a complete reference");
@@ -466,7 +472,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
                                          {"description", config.description},
                                          {"config_path", options.configPath},
                                          {"config_hash", hashHex128(configText)},
-                                         {"config", nlohmann::json::parse(configText)},
+                                         {"config", parseJsonText(configText, options.configPath)},
                                          {"runs_total", runs.size()},
                                          {"gilab_version", build::kVersion},
                                          {"git_commit", build::kGitCommit}};
@@ -524,7 +530,13 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
             ++summary.alreadyFinished;
             continue;
         }
-        const std::string status = executeRun(c, *mine[i], keys[i], i + 1, mine.size());
+        std::string status;
+        try {
+            status = executeRun(c, *mine[i], keys[i], i + 1, mine.size());
+        } catch (const ReferenceInterrupted&) {
+            summary.cancelled = true;  // nothing of this run is committed; the next run redoes it
+            break;
+        }
         ++summary.ran;
         if (status == "unsupported") ++summary.unsupported;
         if (status == "nonfinite") ++summary.nonfinite;
