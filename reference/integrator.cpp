@@ -63,7 +63,12 @@ bool isBlack(const glm::vec3& v) {
 Integrator::Integrator(const Scene& scene, const ReferenceSettings& settings,
                        const EmbreeScene& mesh, const LightSampler& lights,
                        const TextureLookup& textures)
-    : m_scene(scene), m_settings(settings), m_mesh(mesh), m_lights(lights), m_textures(textures) {}
+    : m_scene(scene),
+      m_settings(settings),
+      m_mesh(mesh),
+      m_lights(lights),
+      m_textures(textures),
+      m_offsetScale(rayOffsetScale(scene.caps.bounds.lo, scene.caps.bounds.hi)) {}
 
 void Integrator::radiance(const Ray& ray, const RayHit* cameraHit, Sampler& sampler,
                           PathRadiance& out, PathCounters& counters,
@@ -118,7 +123,7 @@ void Integrator::radiance(const Ray& ray, const RayHit* cameraHit, Sampler& samp
         const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv);
         const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv);
         const Bsdf bsdf(sp.n, glm::vec3(baseColor), metalRough.x, metalRough.y);
-        const glm::vec3 origin = offsetRayOrigin(sp.p, sp.ng);
+        const glm::vec3 origin = offsetRayOrigin(sp.p, sp.ng, m_offsetScale);
         glm::vec3& Lk = out.L[int(layerForVertex(k))];
 
         // Next-event estimation: every punctual light (delta lights, lights.glsl formulas)
@@ -166,7 +171,8 @@ void Integrator::radiance(const Ray& ray, const RayHit* cameraHit, Sampler& samp
                         const float w = estimator == Estimator::Mis
                                             ? powerHeuristic(pdfLight, bsdf.pdf(wo, wi))
                                             : 1.0f;
-                        const glm::vec3 target = offsetRayOrigin(es.p, cosL > 0.0f ? lt.n : -lt.n);
+                        const glm::vec3 target =
+                            offsetRayOrigin(es.p, cosL > 0.0f ? lt.n : -lt.n, m_offsetScale);
                         const glm::vec3 dir = target - origin;
                         ++counters.shadowRays;
                         if (sink) sink->push_back({origin, dir, 0.0f, kShadowTFar, true});

@@ -56,6 +56,7 @@ private:
     const EmbreeScene& m_mesh;
     const LightSampler& m_lights;
     const TextureLookup& m_textures;
+    float m_offsetScale = 1.0f;  // offsetRayOrigin originScale of this scene
 };
 
 /** Camera rays in rtcIntersect16 packets of 4 x 4 pixels (default) or one rtcIntersect1 per

@@ -305,7 +305,8 @@ std::string PathTracer::toString() const {
         << "seed: " << s.seed << "\n"
         << "pixel filter: " << pixelFilterName(s.pixelFilter) << "\n"
         << "batch_samples: " << s.batchSamples << " (does not change the image)\n"
-        << "pixel_filter: box over the pixel\n"
+        << "ray_offsets: 256 ulps along the geometric normal; fixed step near the origin scaled by "
+           "min(1, scene magnitude)\n"
         << "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
         << "punctual_lights: " << im.lights.punctualCount() << ", all evaluated at every vertex\n"
         << "emissive_triangles: " << im.lights.emitterCount()

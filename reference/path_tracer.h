@@ -49,7 +49,7 @@ enum class PixelFilter { Box, Center };
 const char* pixelFilterName(PixelFilter f);  // "box", "center"
 
 /** Bumped whenever a change alters the images; part of every reference cache key. */
-inline constexpr int kRendererVersion = 1;
+inline constexpr int kRendererVersion = 2;  // 2: scale-aware ray offsets (issue 15)
 
 struct ReferenceSettings {
     /** Indirect bounces computed: 0 = emission + direct only; paths have at most

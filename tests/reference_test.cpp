@@ -874,9 +874,13 @@ TEST(CpuReferenceStop, DescriptionNamesEverySetting) {
     st.rouletteStartBounce = 3;
     PathTracer tracer(scene, st);
     const std::string d = tracer.toString();
-    for (const char* part : {"v1", "estimator: nee", "max_bounces: 9", "roulette_start_bounce: 3",
-                             "seed: 42", "batch_samples: 4", "embree: 3."})
+    const std::string version = "v" + std::to_string(kRendererVersion);
+    for (const char* part :
+         {version.c_str(), "estimator: nee", "max_bounces: 9", "roulette_start_bounce: 3",
+          "seed: 42", "batch_samples: 4", "pixel filter: ", "ray_offsets: ", "embree: 3."})
         EXPECT_NE(d.find(part), std::string::npos) << part << " in\n" << d;
+    // One description of the pixel filter, the one in use (it was also a fixed "box" line)
+    EXPECT_EQ(d.find("pixel_filter:"), std::string::npos) << d;
     EXPECT_THROW(PathTracer(scene, settingsWith(Estimator::Mis, -1)), Error);
 }
 

@@ -332,7 +332,8 @@ Light parseLight(const JsonNode& node) {
 
 SceneDescription parseSceneDescription(const JsonNode& root, const std::string& baseDir) {
     root.expectKeys({"name", "gltf", "procedural", "camera", "resolution", "exposure_ev", "lights",
-                     "extra_lights", "material_overrides", "remove_emissive", "animation"});
+                     "extra_lights", "material_overrides", "remove_emissive", "scale",
+                     "animation"});
     SceneDescription d;
     d.context = root.context();
     if (root.has("name")) {
@@ -380,6 +381,12 @@ SceneDescription parseSceneDescription(const JsonNode& root, const std::string& 
         }
     }
     d.removeEmissive = booleanOr(root, "remove_emissive", false);
+    if (root.has("scale")) {
+        d.scale = root["scale"].numberIn(1e-6, 1e6);
+        if (root.has("animation") && d.scale != 1.0)
+            root["scale"].fail(
+                "cannot scale an animated scene (its keys are in the unscaled units)");
+    }
     if (root.has("animation")) d.animation = parseAnimation(root["animation"]);
     return d;
 }

@@ -58,6 +58,8 @@ struct SceneDescription {
     std::vector<Light> extraLights;            // appended
     std::vector<MaterialOverride> materialOverrides;
     bool removeEmissive = false;
+    /** Uniform scale of every length (geometry, camera, light positions; docs/scenes.md). */
+    double scale = 1.0;
     std::optional<AnimationDescription> animation;
 };
 

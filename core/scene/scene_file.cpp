@@ -81,6 +81,24 @@ void applyCamera(Scene& scene, const SceneDescription& d, bool sourceHasCamera) 
     if (!(c.farZ > c.nearZ)) throw Error(where + "far must exceed near");
 }
 
+/**
+ * Multiplies every length by `s`: vertex positions, point and spot light positions, the camera's
+ * position, target and clip planes. Radiance, intensities and directions are kept, so an
+ * emitter-lit scene renders the same image at any scale (point lights: irradiance / s^2).
+ */
+void applyScale(Scene& scene, double s) {
+    const float f = float(s);
+    for (Vertex& v : scene.vertices)
+        v.position *= f;
+    for (Light& l : scene.lights)
+        if (l.type != LightType::Directional) l.position *= f;
+    scene.camera.position *= f;
+    scene.camera.target *= f;
+    scene.camera.nearZ *= f;
+    scene.camera.farZ *= f;
+    scene.computeCaps();
+}
+
 /** Loads the geometry source and applies everything else in the description. */
 Scene buildScene(const SceneDescription& d) {
     Scene scene;
@@ -101,6 +119,7 @@ Scene buildScene(const SceneDescription& d) {
     scene.lights.insert(scene.lights.end(), d.extraLights.begin(), d.extraLights.end());
     scene.computeCaps();  // bounds for a framing camera
     applyCamera(scene, d, hasCamera);
+    if (d.scale != 1.0) applyScale(scene, d.scale);
     if (d.resolution) {
         scene.settings.width = d.resolution->x;
         scene.settings.height = d.resolution->y;

@@ -136,8 +136,8 @@ int runMain(int argc, char** argv) {
                                           build::kGitCommit + ", " + build::kBuildType + ")");
     app.footer(
         "Documentation: docs/ (start with docs/tutorial.md). Exit codes: 0 ok, 1 error, "
-        "2 usage, 3 unsupported, 4 non-finite pixels, 5 validation messages, 130 "
-        "interrupted.");
+        "2 usage, 3 unsupported, 4 non-finite pixels, 5 validation messages, 6 audit found a "
+        "red cell, 130 interrupted.");
 
     std::string commandLine;
     for (int i = 0; i < argc; ++i)
@@ -305,6 +305,36 @@ int runMain(int argc, char** argv) {
     runCmd->add_flag("--dry-run", run.dryRun, "List the runs and which are finished; run nothing");
     runCmd->add_flag("--quiet,-q", run.quiet, "No progress lines");
 
+    audit::AuditOptions auditOptions;
+    auditOptions.commandLine = commandLine;
+    bool auditNoValidation = false;
+    CLI::App* auditCmd = app.add_subcommand(
+        "audit",
+        "Every technique and the path tracer on stiff and extreme cases: a green/amber/red "
+        "stability table (docs/audit.md)");
+    auditCmd
+        ->add_option("--techniques", auditOptions.techniques,
+                     "Techniques (comma-separated); default: every registered technique")
+        ->delimiter(',');
+    auditCmd
+        ->add_option(
+            "--cases", auditOptions.cases,
+            "Cases (comma-separated) of the catalog; default: all (--quick: the quick ones)")
+        ->delimiter(',');
+    auditCmd->add_flag("--quick", auditOptions.quick,
+                       "The reduced audit of ctest: quick cases at the quick profile's resolution");
+    auditCmd->add_option("--out,-o", auditOptions.outDir, "Output folder")->capture_default_str();
+    auditCmd->add_option(
+        "--catalog", auditOptions.catalogPath,
+        "Case catalog (default: experiments/configs/audit.json of the source tree)");
+    auditCmd->add_option("--reference-cache", auditOptions.referenceCache,
+                         "Reference cache folder (default: <out>/cache)");
+    auditCmd->add_option("--device", auditOptions.device, "Vulkan device name substring or index");
+    auditCmd->add_flag(
+        "--no-validation", auditNoValidation,
+        "Run without the Vulkan validation layers (default: on; any message is red)");
+    auditCmd->add_flag("--quiet,-q", auditOptions.quiet, "No progress lines");
+
     std::vector<std::string> reportDirs;
     std::string reportOut;
     CLI::App* reportCmd = app.add_subcommand(
@@ -370,6 +400,10 @@ int runMain(int argc, char** argv) {
             return runExperimentCommand(run);
         }
         if (*reportCmd) return runReport(reportDirs, reportOut);
+        if (*auditCmd) {
+            auditOptions.validation = !auditNoValidation;
+            return runAuditCommand(auditOptions);
+        }
         if (*compareCmd) return runCompare(compare);
     } catch (const UsageError& e) {
         std::fprintf(stderr, "gilab: error: %s\n", e.what());

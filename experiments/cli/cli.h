@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "experiments/audit/audit.h"
 #include "experiments/runner/runner.h"
 
 #include <nlohmann/json.hpp>
@@ -23,6 +24,7 @@ enum ExitCode : int {
     kExitUnsupported = 3,  // the technique cannot run on this scene (reason printed and saved)
     kExitNonFinite = 4,    // the run finished but an output has NaN/Inf pixels (counted, saved)
     kExitInvalid = 5,      // validation was on and reported an error or warning (messages saved)
+    kExitAuditRed = 6,     // `gilab audit` found a red cell (docs/audit.md)
 };
 
 /** A bad command line (exit code 2), thrown by the commands' own argument checks. */
@@ -118,6 +120,9 @@ struct BenchReferenceOptions {
     std::string commandLine;
 };
 int runBenchReference(const BenchReferenceOptions& options);
+
+/** `gilab audit`; see experiments/audit/audit.h. Exit 6 on any red cell, 130 interrupted. */
+int runAuditCommand(audit::AuditOptions options);
 
 /** `gilab run CONFIG`; see experiments/runner/runner.h. */
 int runExperimentCommand(const exp::RunnerOptions& options);

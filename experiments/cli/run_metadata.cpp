@@ -281,6 +281,11 @@ nlohmann::ordered_json memoryJson(const MemoryReport& memory) {
             {"by_resource", tags}};
 }
 
+bool isRadianceLayer(const std::string& name) {
+    return name == "final" || name == "indirect" || name == "direct" || name == "emission" ||
+           name == "albedo";
+}
+
 nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t* nonFinite) {
     nlohmann::ordered_json out;
     size_t total = 0;
@@ -290,6 +295,8 @@ nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t*
                            {"inf_pixels", s.infPixels},
                            {"negative_pixels", s.negativePixels}};
         total += s.nanPixels + s.infPixels;
+        // Radiance and albedo must not be negative (normals and signed debug views may be).
+        if (isRadianceLayer(layer.name)) total += s.negativePixels;
     }
     if (nonFinite) *nonFinite = total;
     return out;

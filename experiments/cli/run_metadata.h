@@ -38,7 +38,12 @@ nlohmann::ordered_json memoryJson(const MemoryReport& memory);
 nlohmann::ordered_json takeValidationJson(vk::Context& ctx);
 /** errors + warnings of a takeValidationJson() block (0 for anything else). */
 uint32_t validationMessageCount(const nlohmann::ordered_json& validation);
-/** {layer: {nan, inf, negative}} and the total non-finite pixel count in `*nonFinite`. */
+/** The layers that hold radiance or albedo, where a negative value is a defect. */
+bool isRadianceLayer(const std::string& name);
+/**
+ * {layer: {nan_pixels, inf_pixels, negative_pixels}}; `nonFinite` gets the NaN and Inf pixels
+ * of every layer plus the negative pixels of the radiance layers (isRadianceLayer).
+ */
 nlohmann::ordered_json finiteJson(const std::vector<ImageLayer>& layers, size_t* nonFinite);
 std::string isoDateUtc();
 

@@ -79,10 +79,21 @@ SequenceResult runSequence(FrameHarness& harness, const SequenceInputs& in) {
         nlohmann::ordered_json stats = nlohmann::ordered_json::object();
         for (const auto& [name, value] : harness.stats())  // the technique's numbers this frame
             stats[name] = numberOrNull(value);
+        // Every measured frame's pixels are counted like the static frame's (a NaN that appears
+        // only while the light moves makes the run "nonfinite").
+        size_t frameNonFinite = 0;
+        const nlohmann::ordered_json finite = cli::finiteJson(layers, &frameNonFinite);
+        out.nonFinitePixels += frameNonFinite;
+        const Image* indirect = findLayer(layers, "indirect");
+        const Image& refIndirect = m.indirect.empty() ? m.fullIndirect : m.indirect;
+        const double energy =
+            indirect ? metrics::computeEnergyRatio(*indirect, refIndirect) : std::nan("");
         frames.push_back({{"frame", frame},
                           {"time_s", animation.frameTime(frame)},
                           {"final_vs_full", vsFull},
                           {"final", vsMatched},
+                          {"energy_ratio", numberOrNull(energy)},
+                          {"nonfinite", finite},
                           {"stats", stats}});
         fullFlip.push_back(vsFull["flip"].value("mean", std::nan("")));
         fullRelMse.push_back(vsFull.value("rel_mse", std::nan("")));

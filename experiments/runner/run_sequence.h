@@ -29,7 +29,8 @@ struct SequenceResult {
     nlohmann::ordered_json timing;       // dynamic_frame_*_ms, update_cpu_ms, update_passes
     std::vector<std::string> framePngs;  // relative to the run folder
     std::string temporalPng;
-    std::string update;  // the update kind of the dynamic frames ("incremental", ...)
+    std::string update;          // the update kind of the dynamic frames ("incremental", ...)
+    size_t nonFinitePixels = 0;  // NaN/Inf/negative pixels over the measured frames' layers
 };
 
 struct SequenceInputs {

@@ -360,6 +360,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                           tm,
                           tmp};
         sequence = runSequence(*harness, in);
+        nonFinite += sequence->nonFinitePixels;
         result["timing"].update(sequence->timing);
         result["animation"] = {{"frames", scene.animation.frameCount},
                                {"duration_s", scene.animation.duration},

@@ -3,7 +3,8 @@
 // words (r, g, b; float sums, or uint fixed point when INJECT_FIXED_POINT), 3 the radiance
 // volume's base (shade only; INJECT_FORMAT = rgba16f or rgba32f), 4 three irradiance planes
 // (sum over lights of each light's mean photon irradiance; float or fixed point), 5 the photon
-// count of the light being splatted per voxel (uint), 6 the light views.
+// count (fixed point) or deposit area (float) of the light being splatted per voxel, 6 the light
+// views.
 #ifndef GILAB_VCT_INJECT_COMMON_GLSL
 #define GILAB_VCT_INJECT_COMMON_GLSL
 
@@ -30,9 +31,17 @@ layout(set = 0, binding = 4, std430) buffer IrradiancePlanes {
     float v[];
 } irradiancePlanes[3];
 #endif
+#ifdef INJECT_FIXED_POINT
 layout(set = 0, binding = 5, std430) buffer CountPlane {
     uint photonCount[];
 };
+#else
+// Float accumulation: the summed footprint area of the deposits per voxel (m^2), so the voxel's
+// irradiance is the area-weighted mean (splat_dense_body.glsl)
+layout(set = 0, binding = 5, std430) buffer WeightPlane {
+    float depositArea[];
+};
+#endif
 layout(set = 0, binding = 6, std430) readonly buffer LightViews {
     LightView views[];
 };

@@ -38,6 +38,11 @@ vec3 footprintCellOffset(FootprintCells f, int a, int b) {
            ((float(b) + 0.5) / float(f.ky) - 0.5) * f.ey;
 }
 
+// Area (world) of one cell of the (clipped) footprint: the weight of its deposits.
+float footprintCellArea(FootprintCells f) {
+    return length(cross(f.ex, f.ey)) / float(f.kx * f.ky);
+}
+
 // Whether the tangent plane (normal n) through grid point g crosses voxel c within rg (grid
 // units) of g: the deposit rule of both splats.
 bool footprintTouchesVoxel(ivec3 c, vec3 g, vec3 n, float rg) {

@@ -39,9 +39,15 @@ layout(set = 0, binding = 6, rgba16f) uniform image3D svoGeometry;
 layout(set = 0, binding = 7, std430) buffer SvoLights {
     uint svoLights[];
 };
+#ifdef SVO_FLOAT_ACCUM
+layout(set = 0, binding = 8, std430) buffer SvoCounts {
+    float svoCount[];  // summed deposit area (m^2) of the light being splatted (svo_splat_body)
+};
+#else
 layout(set = 0, binding = 8, std430) buffer SvoCounts {
     uint svoCount[];
 };
+#endif
 layout(set = 0, binding = 9, rgba8_snorm) uniform image3D svoNormals;
 
 // Words of light l in svoLights (SparseVoxelOctree::kLightWords per light).

@@ -6,6 +6,8 @@
 //   SVO_SPLAT_IRRADIANCE: every deposit adds E / count (E the photon's irradiance),
 // so each leaf sample ends up with this light's mean irradiance over its deposits, summed over
 // the lights (the counts are cleared before each light). Exact for a plane at any orientation.
+// With float accumulation each deposit weighs its footprint cell's area instead of 1 (the
+// area-weighted mean, as the dense splat: vct/splat_dense_body.glsl).
 //
 // Deposits: the photon's footprint on its tangent plane is cut into kx x ky cells of at most
 // v0 / 2 per side; every covered voxel that the plane crosses within a cell's half-diagonal of a
@@ -66,7 +68,7 @@ void addIrradiance(uint base, vec3 e) {
 
 // Deposits at grid point g (on the tangent plane of normal n) into every covered voxel that the
 // plane crosses within rg (grid units, <= 1/2: at most 2 voxels per axis) of g.
-void deposit(vec3 g, vec3 n, float rg, vec3 e, bool countMode) {
+void deposit(vec3 g, vec3 n, float rg, vec3 e, bool countMode, float area) {
     ivec3 lo = ivec3(floor(g - rg));
     ivec3 hi = ivec3(floor(g + rg));
     for (int z = lo.z; z <= hi.z; ++z) {
@@ -76,12 +78,21 @@ void deposit(vec3 g, vec3 n, float rg, vec3 e, bool countMode) {
                 if (!footprintTouchesVoxel(c, g, n, rg)) continue;
                 int index = coveredSample(c);
                 if (index < 0) continue;
+#ifdef SVO_FLOAT_ACCUM
+                if (countMode) {
+                    atomicAdd(svoCount[index], area);
+                } else {
+                    float total = svoCount[index];
+                    if (total > 0.0) addIrradiance(uint(index) * 3u, e * (area / total));
+                }
+#else
                 if (countMode) {
                     atomicAdd(svoCount[index], 1u);
                 } else {
                     uint count = svoCount[index];
                     if (count > 0u) addIrradiance(uint(index) * 3u, e / float(count));
                 }
+#endif
             }
         }
     }
@@ -127,8 +138,9 @@ void main() {
     FootprintCells cells = footprintCells(ex, ey, v0);
 
     vec3 g0 = (p.positionValid.xyz - svo.originVoxelSize.xyz) / v0;
+    float cellArea = footprintCellArea(cells);
     for (int b = 0; b < cells.ky; ++b)
         for (int a = 0; a < cells.kx; ++a)
             deposit(g0 + footprintCellOffset(cells, a, b) / v0, n, cells.radius / v0, e,
-                    countMode);
+                    countMode, cellArea);
 }
