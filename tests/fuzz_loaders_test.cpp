@@ -17,6 +17,7 @@
 
 #include "core/scene/scene_loader.h"
 #include "core/util/error.h"
+#include "experiments/audit/audit.h"
 #include "experiments/runner/experiment_config.h"
 
 namespace fs = std::filesystem;
@@ -78,7 +79,7 @@ std::string mutate(std::string s, std::mt19937& rng) {
     return s;
 }
 
-enum class Loader { Scene, Gltf, Config };
+enum class Loader { Scene, Gltf, Config, AuditCatalog };
 
 /** Loads `path`; "" when it loaded or failed with gilab::Error, else what else it threw.
  *  `loaded` (optional) counts the inputs that loaded. */
@@ -86,6 +87,8 @@ std::string tryLoad(Loader kind, const fs::path& path, int* loaded = nullptr) {
     try {
         if (kind == Loader::Config)
             (void)exp::loadExperimentConfig(path.string());
+        else if (kind == Loader::AuditCatalog)
+            (void)audit::loadCatalog(path.string());
         else if (kind == Loader::Gltf)
             (void)loadGltf(path.string());
         else
@@ -107,11 +110,14 @@ struct Input {
 
 std::vector<Input> inputs() {
     std::vector<Input> out;
-    for (const char* dir : {"scenes", "scenes/stress"})
+    for (const char* dir : {"scenes", "scenes/stress", "scenes/audit"})
         for (const auto& e : fs::directory_iterator(kRoot / dir))
             if (e.path().extension() == ".json") out.push_back({Loader::Scene, e.path()});
     for (const auto& e : fs::directory_iterator(kRoot / "experiments" / "configs"))
-        if (e.path().extension() == ".json") out.push_back({Loader::Config, e.path()});
+        if (e.path().extension() == ".json")
+            out.push_back(
+                {e.path().filename() == "audit.json" ? Loader::AuditCatalog : Loader::Config,
+                 e.path()});
     // The shared scene data may be absent (a clone outside the project folder): then the glTF
     // loader is fuzzed only through the regression corpus.
     const fs::path gltf = fs::path(GILAB_SHARED_SCENES_DIR) / "cornell-box" / "cornell_box.gltf";
