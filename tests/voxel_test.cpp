@@ -160,7 +160,11 @@ TEST(CpuVoxelGrid, FitsTheBoundsAndRejectsBadResolutions) {
             VoxelGrid g2(b, bad);
             FAIL() << "resolution " << bad << " accepted";
         } catch (const Error& e) {
-            EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+            // Named after the techniques' parameter, with the largest grid this device takes
+        EXPECT_NE(std::string(e.what()).find("voxel_resolution = 512"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("the largest grid here is "), std::string::npos)
+            << e.what();
         }
     }
 }
@@ -344,7 +348,11 @@ TEST_F(GpuVoxelTest, TooLargeForTheDeviceNamesTheResolution) {
         Voxelizer v(*m_ctx, gpuScene, unitGrid(512));
         FAIL() << "512^3 accepted";
     } catch (const Error& e) {
-        EXPECT_NE(std::string(e.what()).find("resolution"), std::string::npos) << e.what();
+        // Named after the techniques' parameter, with the largest grid this device takes
+        EXPECT_NE(std::string(e.what()).find("voxel_resolution = 512"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("the largest grid here is "), std::string::npos)
+            << e.what();
         std::printf("[voxel] 512^3: %s\n", e.what());
     }
 }

@@ -1,5 +1,6 @@
 #include "core/voxel/voxelizer.h"
 
+#include <cmath>
 #include <cstring>
 #include <optional>
 #include <string>
@@ -74,10 +75,17 @@ void Voxelizer::createAccumulation(const VoxelizerOptions& options) {
     const VkDeviceSize planeBytes = VkDeviceSize(m_grid.voxelCount()) * 4;
     const VkDeviceSize maxRange = ctx.properties().limits.maxStorageBufferRange;
     if (planeBytes > maxRange) {
-        throw Error("Voxelizer: resolution = " + std::to_string(m_grid.resolution()) + " needs " +
-                    std::to_string(planeBytes >> 20) + " MiB per accumulator binding, above " +
-                    "the device's maxStorageBufferRange (" + std::to_string(maxRange >> 20) +
-                    " MiB)");
+        // Named after the techniques' parameter, with the largest grid this device allows
+        uint32_t largest = uint32_t(std::cbrt(double(maxRange / 4)));
+        while (VkDeviceSize(largest + 1) * (largest + 1) * (largest + 1) * 4 <= maxRange)
+            ++largest;
+        while (largest > 0 && VkDeviceSize(largest) * largest * largest * 4 > maxRange)
+            --largest;
+        throw Error("voxel_resolution = " + std::to_string(m_grid.resolution()) +
+                    " is too large for this device: one voxelizer accumulator needs " +
+                    std::to_string(planeBytes >> 20) + " MiB, above maxStorageBufferRange (" +
+                    std::to_string(maxRange >> 20) + " MiB); the largest grid here is " +
+                    std::to_string(largest) + "^3");
     }
     for (uint32_t k = 0; k < kAccumulatorWords; ++k) {
         m_accumulators.emplace_back(

@@ -33,6 +33,9 @@ struct AuditCase {
     std::string scene;              // absolute path (#variant kept); "builtin" for the built-in box
     bool quick = false;             // part of --quick
     std::optional<int> maxBounces;  // the reference's, when the case needs more than the profile
+    /** Russian roulette in the reference after this bounce (closed rooms of albedo ~1, whose
+     *  paths would all run to maxBounces); -1 = off. Unbiased; the same for every cell. */
+    int rouletteStart = -1;
     /** Parameter cases: only the techniques listed run (others are "n/a"); values are strings
      *  as on the command line, "shared.x" keys go to the shared passes. */
     bool parameterCase = false;

@@ -85,8 +85,9 @@ Catalog loadCatalog(const std::string& path) {
     std::map<std::string, int> seen;
     for (size_t i = 0; i < cases.arraySize(); ++i) {
         const JsonNode n = cases.item(i);
-        n.expectKeys({"name", "what", "scene", "quick", "max_bounces", "params", "parameter_case",
-                      "leak_scale", "scale_group", "scale_base", "documented_failure"});
+        n.expectKeys({"name", "what", "scene", "quick", "max_bounces", "roulette_start_bounce",
+                      "params", "parameter_case", "leak_scale", "scale_group", "scale_base",
+                      "documented_failure"});
         AuditCase a;
         a.name = n["name"].string();
         if (a.name.empty() ||
@@ -97,6 +98,8 @@ Catalog loadCatalog(const std::string& path) {
         a.scene = resolveScene(n["scene"], base);
         a.quick = booleanOr(n, "quick", false);
         if (n.has("max_bounces")) a.maxBounces = n["max_bounces"].integerIn(0, 1024);
+        if (n.has("roulette_start_bounce"))
+            a.rouletteStart = n["roulette_start_bounce"].integerIn(-1, 1024);
         if (n.has("params")) a.params = parseTechniqueParams(n["params"]);
         a.parameterCase = booleanOr(n, "parameter_case", false);
         if (a.parameterCase && a.params.empty())

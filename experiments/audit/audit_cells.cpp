@@ -59,6 +59,7 @@ Json referenceJson(const AuditCase& c, const Profile& p) {
             {"max_bounces", c.maxBounces.value_or(p.maxBounces)},
             {"seed", 1},
             {"pixel_filter", "center"},
+            {"roulette_start_bounce", c.rouletteStart},
             {"frames", 1}};
 }
 
@@ -131,6 +132,26 @@ std::optional<double> worstEnergy(const Json& result) {
     return worst;
 }
 
+/**
+ * Animated cases: light in a frame whose reference is black (below 1e-3 of the brightest
+ * frame's mean, e.g. the light inside a wall), over the brightest reference frame's mean.
+ */
+std::optional<double> darkFrameLeak(const Json& result) {
+    if (!result.contains("metrics") || !result["metrics"].contains("sequence")) return std::nullopt;
+    const Json& frames = result["metrics"]["sequence"]["frames"];
+    double brightest = 0.0;
+    for (const Json& f : frames)
+        brightest = std::max(brightest, numberAt(f, {"reference_mean_luminance"}).value_or(0.0));
+    std::optional<double> leak;
+    for (const Json& f : frames) {
+        const std::optional<double> ref = numberAt(f, {"reference_mean_luminance"});
+        const std::optional<double> test = numberAt(f, {"final_mean_luminance"});
+        if (!ref || !test || !(brightest > 0.0) || *ref > 1e-3 * brightest) continue;
+        leak = std::max(leak.value_or(0.0), *test / brightest);
+    }
+    return leak;
+}
+
 void readResult(const fs::path& runDir, CellResult& cell) {
     const Json result = Json::parse(std::ifstream(runDir / "result.json"));
     cell.runDir = runDir.string();
@@ -150,6 +171,7 @@ void readResult(const fs::path& runDir, CellResult& cell) {
     if (numberAt(result, {"technique", "indirect_bounces"}).value_or(1.0) != 0.0)
         cell.energyRatio = worstEnergy(result);
     cell.clampedPercent = numberAt(result, {"stats", "clamped_energy_percent"});
+    cell.leak = darkFrameLeak(result);
     cell.setupMs = numberAt(result, {"timing", "setup_ms", "total"}).value_or(0.0);
     cell.frameMs =
         numberAt(result, {"timing", "frame_gpu_ms", "median"})

@@ -118,7 +118,7 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
         v.add(Grade::Amber,
               fmt("clamp removed %.1f %% of the indirect light", *cell.clampedPercent));
     if (cell.leak && *cell.leak > t.leakAmber)
-        v.add(Grade::Amber, fmt("leak: %.2f %% of the lit room's mean", 100.0 * *cell.leak));
+        v.add(Grade::Amber, fmt("leak: %.2f %% of the lit view's mean", 100.0 * *cell.leak));
     if (cell.scaleRatio) {
         const double d = std::abs(*cell.scaleRatio - 1.0);
         if (!(d <= t.scaleRed))
@@ -129,7 +129,7 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
     cell.grade = v.grade;
     cell.reason = v.reasons;
     if (cell.reason.empty() && cell.leak)
-        cell.reason = fmt("leak %.3g %% of the lit room's mean", 100.0 * *cell.leak);
+        cell.reason = fmt("leak %.3g %% of the lit view's mean", 100.0 * *cell.leak);
     else if (cell.reason.empty() && cell.energyRatio)
         cell.reason = fmt("indirect energy %.3g x matched", *cell.energyRatio);
     else if (cell.reason.empty() && cell.outcome == "ok")

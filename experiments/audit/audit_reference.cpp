@@ -118,6 +118,8 @@ ReferenceResult runReferenceCheck(const AuditCase& c, const std::string& scene,
         "-o",
         dir.string(),
         "-q"};
+    if (c.rouletteStart >= 0)
+        args.insert(args.end(), {"--roulette-depth", std::to_string(c.rouletteStart)});
     if (animated) args.insert(args.end(), {"--frames", "all"});
     const ChildExit e = runChild(args, log, profile.cellTimeoutS, options.cancel);
     if (e.cancelled || (e.exited && e.code == 130)) {

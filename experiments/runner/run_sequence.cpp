@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <map>
 
+#include "core/image/color.h"
 #include "core/scene/animation.h"
 #include "core/util/error.h"
 #include "experiments/cli/run_metadata.h"
@@ -36,6 +37,14 @@ double meanOf(const std::vector<double>& v) {
 
 nlohmann::ordered_json numberOrNull(double v) {
     return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
+
+double meanLuminance(const Image& rgb) {
+    double sum = 0.0;
+    for (int y = 0; y < rgb.height(); ++y)
+        for (int x = 0; x < rgb.width(); ++x)
+            sum += luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
+    return rgb.width() * rgb.height() > 0 ? sum / (double(rgb.width()) * rgb.height()) : 0.0;
 }
 
 }  // namespace
@@ -93,6 +102,10 @@ SequenceResult runSequence(FrameHarness& harness, const SequenceInputs& in) {
                           {"final_vs_full", vsFull},
                           {"final", vsMatched},
                           {"energy_ratio", numberOrNull(energy)},
+                          // Mean Rec.709 luminance of the image and of the matched reference: a
+                          // frame whose reference is black (a light inside a wall) shows leaks
+                          {"final_mean_luminance", numberOrNull(meanLuminance(final))},
+                          {"reference_mean_luminance", numberOrNull(meanLuminance(m.final))},
                           {"nonfinite", finite},
                           {"stats", stats}});
         fullFlip.push_back(vsFull["flip"].value("mean", std::nan("")));
