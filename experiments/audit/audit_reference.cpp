@@ -38,7 +38,7 @@ void addFrame(const fs::path& dir, ReferenceResult& r, double& sumMean, double& 
               double& tail, double& indirect) {
     const Json meta = Json::parse(std::ifstream(dir / "reference.json"));
     r.nonFiniteSamples += meta.value("nonfinite_samples", size_t(0));
-    r.relError = std::max(r.relError, meta.value("rel_error", 0.0));
+    const double relError = meta.value("rel_error", 0.0);
     r.seconds += meta.value("seconds", 0.0);
     const fs::path exr = dir / "reference.exr";
     r.exrPath = exr.string();
@@ -77,6 +77,7 @@ void addFrame(const fs::path& dir, ReferenceResult& r, double& sumMean, double& 
             if (v > 20.0 * median && v > 0.5) ++r.fireflyPixels;
     }
     r.pixels += size_t(full.width()) * full.height();
+    if (mean > 0.0) r.relError = std::max(r.relError, relError);  // a black frame has none
     sumMean += mean * full.width() * full.height();
 }
 

@@ -31,9 +31,9 @@ std::string cellLabel(const CellResult& c) {
     if (c.outcome == "error") return s + " error";
     if (c.nanPixels + c.infPixels + c.negativePixels > 0) return s + " nonfinite";
     if (c.validationMessages > 0) return s + " validation";
-    if (c.leak) return s + " leak " + fmt("%.2g%%", 100.0 * *c.leak);
     if (c.scaleRatio) s += " x" + fmt("%.4f", *c.scaleRatio);
     if (c.energyRatio) s += " e" + fmt("%.2f", *c.energyRatio);
+    if (c.leak) s += " leak " + fmt("%.2g%%", 100.0 * *c.leak);
     if (c.peakRatio && *c.peakRatio > 4.0) s += " p" + fmt("%.3g", *c.peakRatio);
     return s;
 }
