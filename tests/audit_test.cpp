@@ -271,6 +271,22 @@ TEST(GpuAudit, ExitCodeSixOnRedAndOneOnBadInput) {
               std::string::npos);
 }
 
+// SIGTERM (a scheduler's time limit) or Ctrl-C: the audit stops its running cell, keeps the table
+// so far (complete: false) and exits 130.
+TEST(GpuAudit, InterruptKeepsThePartialTable) {
+    test::TempDir dir("gilab_audit_interrupt");
+    const fs::path out = dir.path() / "out";
+    const ChildExit e = runChild({GILAB_EXECUTABLE, "audit", "--quick", "--cases",
+                                  "box_1m,box_1mm,box_5km", "--out", out.string()},
+                                 dir.path() / "log.txt", 8.0, nullptr);
+    EXPECT_TRUE(e.timedOut);
+    EXPECT_TRUE(e.exited) << "killed by signal " << e.signal;
+    EXPECT_EQ(e.code, 130);
+    const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "audit.json"));
+    EXPECT_FALSE(j["complete"].get<bool>());
+    EXPECT_LT(j["references"].size(), 3u);
+}
+
 // The ctest profile of `gilab audit --quick` through the gilab binary: no red, and a complete
 // table (a reference row per case, a cell per technique x case).
 TEST(GpuAudit, QuickAuditHasNoRed) {

@@ -73,6 +73,17 @@ static std::string findReportScript() {
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
     for (const std::string& d : dirs)
         if (!std::filesystem::is_directory(d)) throw Error("report: no such results folder: " + d);
+    // An audit folder's report is the table `gilab audit` wrote (docs/audit.md)
+    if (dirs.size() == 1 &&
+        std::filesystem::exists(std::filesystem::path(dirs[0]) / "audit.json") &&
+        !std::filesystem::exists(std::filesystem::path(dirs[0]) / "runs")) {
+        std::printf(
+            "%s is a `gilab audit` folder: its report is %s (table: %s; each cell's run "
+            "folder under cells/ takes `gilab report`)\n",
+            dirs[0].c_str(), (std::filesystem::path(dirs[0]) / "audit.html").c_str(),
+            (std::filesystem::path(dirs[0]) / "audit.md").c_str());
+        return kExitOk;
+    }
     const std::string script = findReportScript();
     const char* python = "/usr/bin/python3";  // Debian's, with python3-matplotlib
     std::vector<std::string> args{python, script};
