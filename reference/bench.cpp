@@ -39,10 +39,12 @@ BenchConvergence measureConvergence(const Scene& scene, const ReferenceSettings&
     BenchConvergence conv;
     conv.targetRelMse = o.targetRelMse;
     const uint64_t batch = std::max<uint32_t>(settings.batchSamples, 1);
-    conv.predictedSamples = uint64_t(std::ceil(predictRelMseAtOneSample(timed) / o.targetRelMse));
+    // The timed render's few samples only size the long run: their per-pixel variance misses
+    // rare bright paths (on the 256^2 Cornell glTF it predicted 260 spp where 1839 were needed)
+    conv.sizingSamples = uint64_t(std::ceil(predictRelMseAtOneSample(timed) / o.targetRelMse));
     conv.longSamples = o.longSpp
                            ? o.longSpp
-                           : std::clamp<uint64_t>(roundUp(8 * conv.predictedSamples, batch),
+                           : std::clamp<uint64_t>(roundUp(8 * conv.sizingSamples, batch),
                                                   std::max<uint64_t>(64, batch), o.maxLongSpp);
 
     // 1. The long run, with another seed so that it is independent of the fresh run
@@ -58,6 +60,9 @@ BenchConvergence measureConvergence(const Scene& scene, const ReferenceSettings&
             renderUntil(longTracer, longAcc, StopCriteria{conv.longSamples, 0.0, o.maxLongSeconds});
         conv.longSamples = longAcc.samples;
         conv.longSeconds = report.seconds;
+        // The prediction from the long run's variance (many more samples per pixel)
+        conv.predictedSamples =
+            uint64_t(std::ceil(predictRelMseAtOneSample(longAcc) / o.targetRelMse));
         longImage = meanImage(longAcc, Layer::Full);
     }
 
@@ -227,6 +232,7 @@ nlohmann::ordered_json benchSceneJson(const BenchSceneResult& r) {
             {"convergence",
              {{"target_rel_mse", c.targetRelMse},
               {"predicted_samples", c.predictedSamples},
+              {"sizing_samples", c.sizingSamples},
               {"long_samples", c.longSamples},
               {"long_seconds", c.longSeconds},
               {"long_seed", c.longSeed},

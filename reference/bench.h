@@ -54,7 +54,8 @@ struct BenchOptions {
 
 struct BenchConvergence {
     double targetRelMse = 0.0;
-    uint64_t predictedSamples = 0;  // from the timed render's per-pixel variance
+    uint64_t predictedSamples = 0;  // from the long run's per-pixel variance
+    uint64_t sizingSamples = 0;     // from the timed render's (sizes the long run only)
     uint64_t longSamples = 0;
     double longSeconds = 0.0;
     uint64_t longSeed = 0;

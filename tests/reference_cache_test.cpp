@@ -508,6 +508,10 @@ TEST(CpuReferenceBench, ReplayAndConvergenceRunOnATinyScene) {
     EXPECT_LE(r.replay.closest.front().hitsPerPass, r.replay.closestRays);
     EXPECT_GT(r.rawMixRaysPerSecond("1", r.threads), 0.0);
     EXPECT_EQ(r.convergence.longSamples, 64u);
+    // The prediction comes from the long run's variance, the sizing from the timed render's
+    EXPECT_GT(r.convergence.predictedSamples, 0u);
+    EXPECT_GT(r.convergence.sizingSamples, 0u);
+    EXPECT_EQ(ref::benchSceneJson(r)["convergence"]["sizing_samples"], r.convergence.sizingSamples);
     EXPECT_TRUE(r.convergence.reached);
     EXPECT_LT(r.convergence.curve.back().relMseVsLong, 0.5);
     EXPECT_TRUE(ref::benchSceneJson(r)["raw_embree"]["closest"].is_array());

@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include "core/image/color.h"
 #include "core/scene/mesh_builder.h"
 #include "core/scene/procedural_cornell.h"
 #include "core/scene/scene_loader.h"
@@ -866,6 +867,57 @@ TEST(CpuReferenceStop, RelativeMseDefinition) {
     a.at(0, 0, 0) = 2.0f;  // (2 - 1)^2 / (1 + 0.01), averaged over 6 values
     EXPECT_NEAR(relativeMse(a, b), 1.0 / 1.01 / 6.0, 1e-12);
     EXPECT_THROW(relativeMse(a, Image(1, 1, 3)), Error);
+}
+
+// Corner seams at pixel centres (issue 16's robust ray offsets): the McGuire box's geometry
+// [-1, 1] x [0, 2] x [-1, 1], open at +z, seen from (0, 1, 3.9) with a square image, puts the
+// centre of pixel (r, r) exactly on the floor / right-wall edge (x = 1, y = 0) for the lower half
+// of the image. A ray starting there must not start on or behind the adjacent wall: no seam
+// pixel may be black or fall far below its four neighbours.
+TEST(CpuReferenceSeams, CornerSeamPixelsAreNotDarkerThanTheirNeighbours) {
+    Scene s = emptyScene("seam_box", 64);
+    const uint32_t white = addMaterial(s, lambert(glm::vec3(0.7f), glm::vec3(0.0f)));
+    const uint32_t green = addMaterial(s, lambert(glm::vec3(0.1f, 0.6f, 0.1f), glm::vec3(0.0f)));
+    const uint32_t light = addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(10.0f)));
+    appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, white);    // floor
+    appendQuad(s, {-1, 2, -1}, {1, 2, -1}, {1, 2, 1}, {-1, 2, 1}, {0, -1, 0}, white);   // ceiling
+    appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 2, -1}, {-1, 2, -1}, {0, 0, 1}, white);  // back
+    appendQuad(s, {1, 0, -1}, {1, 0, 1}, {1, 2, 1}, {1, 2, -1}, {-1, 0, 0}, green);     // right
+    appendQuad(s, {-1, 0, -1}, {-1, 0, 1}, {-1, 2, 1}, {-1, 2, -1}, {1, 0, 0}, white);  // left
+    appendQuad(s, {-0.25f, 1.99f, -0.25f}, {0.25f, 1.99f, -0.25f}, {0.25f, 1.99f, 0.25f},
+               {-0.25f, 1.99f, 0.25f}, {0, -1, 0}, light);
+    s.camera.position = {0.0f, 1.0f, 3.9f};
+    s.camera.target = {0.0f, 1.0f, 0.0f};
+    s.camera.up = {0.0f, 1.0f, 0.0f};
+    s.camera.vfovRad = glm::radians(39.3f);
+    s.computeCaps();
+    ReferenceSettings st;
+    st.maxBounces = 4;
+    st.pixelFilter = PixelFilter::Center;
+    PathTracer tracer(s, st);
+    Accumulator acc;
+    acc.reset(64, 64);
+    ASSERT_TRUE(tracer.addSamples(acc, 256));
+    auto lum = [&](int x, int y) {
+        return luminance(float(acc.mean(Layer::Full, x, y, 0)),
+                         float(acc.mean(Layer::Full, x, y, 1)),
+                         float(acc.mean(Layer::Full, x, y, 2)));
+    };
+    auto err = [&](int x, int y) { return acc.stdError(Layer::Full, x, y, 1); };
+    int checked = 0;
+    for (int r = 40; r < 62; ++r) {  // the floor / right-wall edge, inside the box
+        const double seam = lum(r, r);
+        const double lowest =
+            std::min({lum(r - 1, r), lum(r + 1, r), lum(r, r - 1), lum(r, r + 1)});
+        EXPECT_GT(seam, 0.0) << "pixel (" << r << ", " << r << ") is black";
+        EXPECT_GT(seam, 0.75 * lowest - 4.0 * err(r, r))
+            << "pixel (" << r << ", " << r << "): " << seam << " vs neighbours >= " << lowest;
+        if (r % 7 == 0)
+            std::printf("seam pixel (%d, %d): %.4f, neighbours %.4f %.4f %.4f %.4f\n", r, r, seam,
+                        lum(r - 1, r), lum(r + 1, r), lum(r, r - 1), lum(r, r + 1));
+        ++checked;
+    }
+    EXPECT_EQ(checked, 22);
 }
 
 TEST(CpuReferenceStop, DescriptionNamesEverySetting) {
