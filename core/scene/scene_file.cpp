@@ -110,7 +110,12 @@ Scene buildScene(const SceneDescription& d) {
             throw Error(d.context + ": \"procedural\": " + e.what());
         }
     } else {
-        gltf::LoadResult loaded = gltf::loadFile(d.gltfPath);
+        gltf::LoadResult loaded;
+        try {
+            loaded = gltf::loadFile(d.gltfPath);
+        } catch (const Error& e) {  // name the description that refers to the glTF too
+            throw Error(d.context + ": \"gltf\": " + e.what());
+        }
         scene = std::move(loaded.scene);
         hasCamera = loaded.hasCamera;
     }
