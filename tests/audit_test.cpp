@@ -276,15 +276,18 @@ TEST(GpuAudit, ExitCodeSixOnRedAndOneOnBadInput) {
 TEST(GpuAudit, InterruptKeepsThePartialTable) {
     test::TempDir dir("gilab_audit_interrupt");
     const fs::path out = dir.path() / "out";
-    const ChildExit e = runChild({GILAB_EXECUTABLE, "audit", "--quick", "--cases",
-                                  "box_1m,box_1mm,box_5km", "--out", out.string()},
-                                 dir.path() / "log.txt", 8.0, nullptr);
+    // The direct baseline's cells stop within a second of the signal; its 18 quick cases take
+    // far longer than 8 s in all
+    const ChildExit e = runChild(
+        {GILAB_EXECUTABLE, "audit", "--quick", "--techniques", "direct", "--out", out.string()},
+        dir.path() / "log.txt", 8.0, nullptr);
     EXPECT_TRUE(e.timedOut);
     EXPECT_TRUE(e.exited) << "killed by signal " << e.signal;
     EXPECT_EQ(e.code, 130);
     const nlohmann::json j = nlohmann::json::parse(std::ifstream(out / "audit.json"));
     EXPECT_FALSE(j["complete"].get<bool>());
-    EXPECT_LT(j["references"].size(), 3u);
+    EXPECT_LT(j["references"].size(), 18u);
+    EXPECT_GE(j["references"].size(), 1u);
 }
 
 // The ctest profile of `gilab audit --quick` through the gilab binary: no red, and a complete
