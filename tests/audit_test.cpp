@@ -31,6 +31,15 @@ CellResult okCell() {
     return c;
 }
 
+/** The grade of a clean cell after `change`, with no case-specific rule. */
+template <class Change>
+Grade grade(Change change) {
+    CellResult c = okCell();
+    change(c);
+    gradeCell(c, AuditCase{});
+    return c.grade;
+}
+
 TEST(CpuAudit, CleanCellIsGreen) {
     CellResult c = okCell();
     gradeCell(c, AuditCase{});
@@ -38,13 +47,6 @@ TEST(CpuAudit, CleanCellIsGreen) {
 }
 
 TEST(CpuAudit, DefectsAreRed) {
-    const AuditCase none;
-    auto grade = [&](auto change) {
-        CellResult c = okCell();
-        change(c);
-        gradeCell(c, none);
-        return c.grade;
-    };
     EXPECT_EQ(grade([](CellResult& c) { c.nanPixels = 1; }), Grade::Red);
     EXPECT_EQ(grade([](CellResult& c) { c.infPixels = 3; }), Grade::Red);
     EXPECT_EQ(grade([](CellResult& c) { c.negativePixels = 1; }), Grade::Red);
@@ -66,13 +68,6 @@ TEST(CpuAudit, DefectsAreRed) {
 }
 
 TEST(CpuAudit, WeaknessesAreAmber) {
-    const AuditCase none;
-    auto grade = [&](auto change) {
-        CellResult c = okCell();
-        change(c);
-        gradeCell(c, none);
-        return c.grade;
-    };
     EXPECT_EQ(grade([](CellResult& c) { c.energyRatio = 0.3; }), Grade::Amber);
     EXPECT_EQ(grade([](CellResult& c) { c.energyRatio = 3.0; }), Grade::Amber);
     EXPECT_EQ(grade([](CellResult& c) { c.peakRatio = 5.0; }), Grade::Amber);

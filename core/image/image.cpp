@@ -1,7 +1,9 @@
 #include "core/image/image.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include "core/image/color.h"
 #include "core/util/error.h"
 
 namespace gilab {
@@ -58,6 +60,27 @@ FiniteStats countNonFinite(const Image& image) {
         stats.negativePixels += negative ? 1 : 0;
     }
     return stats;
+}
+
+double meanLuminance(const Image& rgb) {
+    double sum = 0.0;
+    for (int y = 0; y < rgb.height(); ++y)
+        for (int x = 0; x < rgb.width(); ++x) {
+            const double l = luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
+            if (std::isfinite(l)) sum += l;
+        }
+    const double n = double(rgb.width()) * double(rgb.height());
+    return n > 0.0 ? sum / n : 0.0;
+}
+
+double maxLuminance(const Image& rgb) {
+    double m = 0.0;
+    for (int y = 0; y < rgb.height(); ++y)
+        for (int x = 0; x < rgb.width(); ++x) {
+            const double l = luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
+            if (std::isfinite(l)) m = std::max(m, l);
+        }
+    return m;
 }
 
 }  // namespace gilab

@@ -49,6 +49,10 @@ struct FiniteStats {
 };
 FiniteStats countNonFinite(const Image& image);
 
+/** Mean and maximum Rec.709 luminance of an RGB(A) image's finite pixels (0 when empty). */
+double meanLuminance(const Image& rgb);
+double maxLuminance(const Image& rgb);
+
 /** A named image in a multi-layer file, e.g. {"final", rgb}; channel names follow EXR (R,G,B / Z).
  */
 struct ImageLayer {

@@ -20,26 +20,7 @@ namespace gilab::audit {
 namespace fs = std::filesystem;
 using Json = nlohmann::ordered_json;
 
-double meanLuminance(const Image& rgb) {
-    double sum = 0.0;
-    for (int y = 0; y < rgb.height(); ++y)
-        for (int x = 0; x < rgb.width(); ++x)
-            sum += luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
-    const double n = double(rgb.width()) * rgb.height();
-    return n > 0 ? sum / n : 0.0;
-}
-
 namespace {
-
-double maxLuminance(const Image& rgb) {
-    double m = 0.0;
-    for (int y = 0; y < rgb.height(); ++y)
-        for (int x = 0; x < rgb.width(); ++x) {
-            const double l = luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
-            if (std::isfinite(l)) m = std::max(m, l);
-        }
-    return m;
-}
 
 /** A --set style value as JSON: a number or boolean when it reads as one, else a string. */
 Json valueJson(const std::string& text) {

@@ -35,7 +35,4 @@ ReferenceResult runReferenceCheck(const AuditCase& c, const std::string& scene,
                                   const std::string& label, const Profile& profile,
                                   const AuditOptions& options, const AuditPaths& paths);
 
-/** The mean luminance of an RGB image. */
-double meanLuminance(const Image& rgb);
-
 }  // namespace gilab::audit

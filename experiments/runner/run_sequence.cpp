@@ -4,7 +4,6 @@
 #include <cstdio>
 #include <map>
 
-#include "core/image/color.h"
 #include "core/scene/animation.h"
 #include "core/util/error.h"
 #include "experiments/cli/run_metadata.h"
@@ -37,14 +36,6 @@ double meanOf(const std::vector<double>& v) {
 
 nlohmann::ordered_json numberOrNull(double v) {
     return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
-}
-
-double meanLuminance(const Image& rgb) {
-    double sum = 0.0;
-    for (int y = 0; y < rgb.height(); ++y)
-        for (int x = 0; x < rgb.width(); ++x)
-            sum += luminance(rgb.at(x, y, 0), rgb.at(x, y, 1), rgb.at(x, y, 2));
-    return rgb.width() * rgb.height() > 0 ? sum / (double(rgb.width()) * rgb.height()) : 0.0;
 }
 
 }  // namespace
