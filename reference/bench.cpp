@@ -103,6 +103,14 @@ BenchConvergence measureConvergence(const Scene& scene, const ReferenceSettings&
     return conv;
 }
 
+/** The fastest raw Embree method's rate for the render's ray mix (all threads). */
+double bestRawMix(const BenchSceneResult& r) {
+    double best = 0.0;
+    for (const char* method : {"1", "8", "16", "1M"})
+        best = std::max(best, r.rawMixRaysPerSecond(method, r.threads));
+    return best;
+}
+
 nlohmann::ordered_json rateJson(const ReplayRate& r) {
     return {{"method", r.method},
             {"threads", r.threads},
@@ -228,6 +236,9 @@ nlohmann::ordered_json benchSceneJson(const BenchSceneResult& r) {
                r.rawMixRaysPerSecond("1", r.threads) > 0.0
                    ? r.raysPerSecond() / r.rawMixRaysPerSecond("1", r.threads)
                    : 0.0},
+              {"best_raw_mix_rays_per_second_mt", bestRawMix(r)},
+              {"path_tracer_over_best_raw_mt",
+               bestRawMix(r) > 0.0 ? r.raysPerSecond() / bestRawMix(r) : 0.0},
               {"warnings", r.replay.warnings}}},
             {"convergence",
              {{"target_rel_mse", c.targetRelMse},
@@ -241,6 +252,8 @@ nlohmann::ordered_json benchSceneJson(const BenchSceneResult& r) {
               {"seconds", c.seconds},
               {"extrapolated_samples", c.extrapolatedSamples},
               {"extrapolated_seconds", c.extrapolatedSeconds},
+              {"seconds_per_sample", c.secondsPerSample()},
+              {"efficiency", c.efficiency()},
               {"curve_columns", {"samples", "seconds", "rel_error", "rel_mse_vs_long"}},
               {"curve", curve}}}};
 }

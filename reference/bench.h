@@ -67,6 +67,18 @@ struct BenchConvergence {
     uint64_t extrapolatedSamples = 0;
     double extrapolatedSeconds = 0.0;
     std::vector<ConvergencePoint> curve;
+
+    /** Render seconds per sample per pixel at the last curve point. */
+    double secondsPerSample() const {
+        return curve.empty() || curve.back().samples == 0
+                   ? 0.0
+                   : curve.back().seconds / double(curve.back().samples);
+    }
+    /** 1 / (relative MSE x seconds), independent of the sample count: the target over the
+     *  extrapolated seconds to reach it. */
+    double efficiency() const {
+        return extrapolatedSeconds > 0.0 ? 1.0 / (targetRelMse * extrapolatedSeconds) : 0.0;
+    }
 };
 
 struct BenchSceneResult {

@@ -305,9 +305,11 @@ nlohmann::ordered_json stopCriteriaJson(const StopCriteria& stop) {
 nlohmann::ordered_json settingsJson(const ReferenceSettings& settings) {
     return {{"max_bounces", settings.maxBounces},
             {"roulette_start_bounce", settings.rouletteStartBounce},
+            {"roulette_threshold", settings.rouletteThreshold},
             {"estimator", estimatorName(settings.estimator)},
             {"seed", settings.seed},
             {"pixel_filter", pixelFilterName(settings.pixelFilter)},
+            {"sampler", samplerKindName(settings.sampler)},
             {"batch_samples", settings.batchSamples}};
 }
 

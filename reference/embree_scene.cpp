@@ -189,7 +189,7 @@ bool EmbreeScene::occluded(const glm::vec3& o, const glm::vec3& d, float tNear, 
 }
 
 void EmbreeScene::intersect16(int count, const glm::vec3* o, const glm::vec3* d, float tFar,
-                              RayHit* hit) const {
+                              RayHit* hit, bool coherent) const {
     alignas(64) int valid[16];
     alignas(64) RTCRayHit16 rh;
     for (int i = 0; i < 16; ++i) {
@@ -215,7 +215,8 @@ void EmbreeScene::intersect16(int count, const glm::vec3* o, const glm::vec3* d,
     }
     RTCIntersectContext context;
     rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_COHERENT;
+    context.flags =
+        coherent ? RTC_INTERSECT_CONTEXT_FLAG_COHERENT : RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
     rtcIntersect16(valid, m_scene, &context, &rh);
     for (int i = 0; i < count; ++i) {
         if (rh.hit.geomID[i] == RTC_INVALID_GEOMETRY_ID) {
@@ -227,6 +228,44 @@ void EmbreeScene::intersect16(int count, const glm::vec3* o, const glm::vec3* d,
         hit[i].u = rh.hit.u[i];
         hit[i].v = rh.hit.v[i];
     }
+}
+
+void EmbreeScene::occluded16(int count, const glm::vec3* o, const glm::vec3* d, const float* tFar,
+                             bool* occluded) const {
+    alignas(64) int valid[16];
+    alignas(64) RTCRay16 ray;
+    for (int i = 0; i < 16; ++i) {
+        const bool active = i < count;
+        valid[i] = active ? -1 : 0;
+        const glm::vec3 oi = active ? o[i] : glm::vec3(0.0f);
+        const glm::vec3 di = active ? d[i] : glm::vec3(0.0f, 0.0f, 1.0f);
+        ray.org_x[i] = oi.x;
+        ray.org_y[i] = oi.y;
+        ray.org_z[i] = oi.z;
+        ray.tnear[i] = 0.0f;
+        ray.dir_x[i] = di.x;
+        ray.dir_y[i] = di.y;
+        ray.dir_z[i] = di.z;
+        ray.time[i] = 0.0f;
+        ray.tfar[i] = active ? tFar[i] : 0.0f;
+        ray.mask[i] = ~0u;
+        ray.id[i] = unsigned(i);
+        ray.flags[i] = 0;
+    }
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    rtcOccluded16(valid, m_scene, &context, &ray);
+    for (int i = 0; i < count; ++i)
+        occluded[i] = ray.tfar[i] < 0.0f;  // Embree sets tfar = -inf on a hit
+}
+
+void EmbreeScene::occludedStream(std::vector<RTCRay>& rays) const {
+    if (rays.empty()) return;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    rtcOccluded1M(m_scene, &context, rays.data(), unsigned(rays.size()), sizeof(RTCRay));
 }
 
 }  // namespace gilab::ref

@@ -61,10 +61,17 @@ public:
                    RayHit& hit) const;
     /** Whether anything (not cut out) lies on o + t d, t in [tNear, tFar]. */
     bool occluded(const glm::vec3& o, const glm::vec3& d, float tNear, float tFar) const;
-    /** Closest hits of up to 16 rays in one rtcIntersect16 call; hit[i].prim = ~0u on a miss.
-     *  Lanes >= count are inactive. */
-    void intersect16(int count, const glm::vec3* o, const glm::vec3* d, float tFar,
-                     RayHit* hit) const;
+    /** Closest hits of up to 16 rays (t in [0, tFar]) in one rtcIntersect16 call;
+     *  hit[i].prim = ~0u on a miss. Lanes >= count are inactive. `coherent`: Embree's hint for
+     *  rays of neighbouring pixels (camera rays). */
+    void intersect16(int count, const glm::vec3* o, const glm::vec3* d, float tFar, RayHit* hit,
+                     bool coherent = true) const;
+    /** Occlusion of every ray in one rtcOccluded1M stream call (Embree regroups the rays);
+     *  an occluded ray gets tfar = -inf. */
+    void occludedStream(std::vector<RTCRay>& rays) const;
+    /** Occlusion of up to 16 rays o + t d, t in [0, tFar[i]], in one rtcOccluded16 call. */
+    void occluded16(int count, const glm::vec3* o, const glm::vec3* d, const float* tFar,
+                    bool* occluded) const;
 
     /** Throws gilab::Error with Embree's message if the device reports an error. */
     void checkError(const char* what) const;

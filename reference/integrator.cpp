@@ -1,5 +1,6 @@
 #include "reference/integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -70,151 +71,257 @@ Integrator::Integrator(const Scene& scene, const ReferenceSettings& settings,
       m_textures(textures),
       m_offsetScale(rayOffsetScale(scene.caps.bounds.lo, scene.caps.bounds.hi)) {}
 
-void Integrator::radiance(const Ray& ray, const RayHit* cameraHit, Sampler& sampler,
-                          PathRadiance& out, PathCounters& counters,
-                          std::vector<RecordedRay>* sink) const {
-    for (glm::vec3& l : out.L)
-        l = glm::vec3(0.0f);
+bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& shadows) const {
     const Estimator estimator = m_settings.estimator;
     const bool useNee = estimator != Estimator::BsdfOnly && m_lights.hasEmitters();
     const bool useBsdfHits = estimator != Estimator::NeeOnly && m_lights.hasEmitters();
     const int lastVertex = m_settings.maxBounces + 1;
+    const int k = p.vertex;
+    const RayHit& hit = p.hit;
+    const MeshTriangle& tri = m_mesh.triangle(hit.prim);
+    const glm::vec3 wo = -p.rayD;
+    const SurfacePoint sp = makeSurfacePoint(m_scene, tri, hit, wo);
+    const Material& mat = *sp.material;
+    const glm::vec3 beta = p.beta;
 
-    // Camera ray
-    glm::vec3 rayO = ray.origin, rayD = ray.direction;
-    RayHit hit;
-    bool found;
-    if (cameraHit) {
-        found = cameraHit->prim != ~0u;
-        hit = *cameraHit;
-    } else {
-        found = m_mesh.intersect(rayO, rayD, 0.0f, kInfinity, hit);
-    }
-    ++counters.cameraRays;
-    if (sink) sink->push_back({rayO, rayD, 0.0f, kInfinity, false});
-
-    glm::vec3 beta(1.0f);
-    float prevBsdfPdf = 0.0f;
-    for (int k = 1; found; ++k) {
-        const MeshTriangle& tri = m_mesh.triangle(hit.prim);
-        const glm::vec3 wo = -rayD;
-        const SurfacePoint sp = makeSurfacePoint(m_scene, tri, hit, wo);
-        const Material& mat = *sp.material;
-
-        // Emission towards the previous vertex: the camera (emission layer) or vertex k - 1
-        if (mat.isEmissive() && (sp.frontFace || mat.doubleSided)) {
-            const glm::vec3 le = lookupEmission(mat, m_textures, sp.uv);
-            if (k == 1) {
-                out.L[int(Layer::Emission)] += le;
-            } else if (useBsdfHits) {
-                float w = 1.0f;
-                if (estimator == Estimator::Mis) {
-                    // Light pdf of this point in solid angle at vertex k - 1 (rayD is unit)
-                    const float cosL = std::abs(glm::dot(tri.n, wo));
-                    const float pdfLight =
-                        cosL > 0.0f ? m_lights.pdfArea(hit.prim) * hit.t * hit.t / cosL : 0.0f;
-                    w = powerHeuristic(prevBsdfPdf, pdfLight);
-                }
-                out.L[int(layerForVertex(k - 1))] += beta * le * w;
+    // Emission towards the previous vertex: the camera (emission layer) or vertex k - 1
+    if (mat.isEmissive() && (sp.frontFace || mat.doubleSided)) {
+        const glm::vec3 le = lookupEmission(mat, m_textures, sp.uv);
+        if (k == 1) {
+            out.L[int(Layer::Emission)] += le;
+        } else if (useBsdfHits) {
+            float w = 1.0f;
+            if (estimator == Estimator::Mis) {
+                // Light pdf of this point in solid angle at vertex k - 1 (rayD is unit)
+                const float cosL = std::abs(glm::dot(tri.n, wo));
+                const float pdfLight =
+                    cosL > 0.0f ? m_lights.pdfArea(hit.prim) * hit.t * hit.t / cosL : 0.0f;
+                w = powerHeuristic(p.prevBsdfPdf, pdfLight);
             }
+            out.L[int(layerForVertex(k - 1))] += beta * le * w;
         }
-        if (k > lastVertex) break;
+    }
+    if (k > lastVertex) return false;
 
-        const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv);
-        const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv);
-        const Bsdf bsdf(sp.n, glm::vec3(baseColor), metalRough.x, metalRough.y);
-        const glm::vec3 origin = offsetRayOrigin(sp.p, sp.ng, m_offsetScale);
-        glm::vec3& Lk = out.L[int(layerForVertex(k))];
+    const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv);
+    const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv);
+    const Bsdf bsdf(sp.n, glm::vec3(baseColor), metalRough.x, metalRough.y);
+    const glm::vec3 origin = offsetRayOrigin(sp.p, sp.ng, m_offsetScale);
+    const int layer = int(layerForVertex(k));
 
-        // Next-event estimation: every punctual light (delta lights, lights.glsl formulas)
-        for (size_t i = 0; i < m_lights.punctualCount(); ++i) {
-            glm::vec3 wi;
-            float dist;
-            const glm::vec3 ePerp = m_lights.punctualIrradiance(i, sp.p, wi, dist);
+    // Next-event estimation: every punctual light (delta lights, lights.glsl formulas)
+    for (size_t i = 0; i < m_lights.punctualCount(); ++i) {
+        glm::vec3 wi;
+        float dist;
+        const glm::vec3 ePerp = m_lights.punctualIrradiance(i, sp.p, wi, dist);
+        const float cosTheta = glm::dot(sp.n, wi);
+        if (cosTheta <= 0.0f || isBlack(ePerp) || glm::dot(sp.ng, wi) <= 0.0f) continue;
+        const glm::vec3 f = bsdf.eval(wo, wi);
+        if (isBlack(f)) continue;
+        const Light& light = m_lights.punctual(i);
+        const bool directional = light.type == LightType::Directional;
+        const glm::vec3 dir = directional ? wi : light.position - origin;
+        const float tFar = directional ? kInfinity : kShadowTFar;
+        shadows.push_back({origin, dir, tFar, beta * f * ePerp * cosTheta, p.slot, layer});
+    }
+
+    // Next-event estimation: one point on the emissive triangles, by power
+    if (useNee) {
+        const double uSelect = p.sampler.get1DDouble();
+        const glm::vec2 uPoint = p.sampler.get2D();
+        EmitterSample es;
+        if (m_lights.sampleEmitter(uSelect, uPoint, es)) {
+            const MeshTriangle& lt = m_mesh.triangle(es.prim);
+            const Material& lm = m_scene.materials[lt.material];
+            const glm::vec3 toLight = es.p - sp.p;
+            const float dist2 = glm::dot(toLight, toLight);
+            const float dist = std::sqrt(dist2);
+            const glm::vec3 wi = toLight / dist;
+            const float cosL = glm::dot(lt.n, -wi);
             const float cosTheta = glm::dot(sp.n, wi);
-            if (cosTheta <= 0.0f || isBlack(ePerp) || glm::dot(sp.ng, wi) <= 0.0f) continue;
-            const glm::vec3 f = bsdf.eval(wo, wi);
-            if (isBlack(f)) continue;
-            const Light& light = m_lights.punctual(i);
-            const bool directional = light.type == LightType::Directional;
-            const glm::vec3 dir = directional ? wi : light.position - origin;
-            const float tFar = directional ? kInfinity : kShadowTFar;
-            ++counters.shadowRays;
-            if (sink) sink->push_back({origin, dir, 0.0f, tFar, true});
-            if (m_mesh.occluded(origin, dir, 0.0f, tFar)) continue;
-            Lk += beta * f * ePerp * cosTheta;
-        }
-
-        // Next-event estimation: one point on the emissive triangles, by power
-        if (useNee) {
-            const double uSelect = sampler.get1DDouble();
-            const glm::vec2 uPoint = sampler.get2D();
-            EmitterSample es;
-            if (m_lights.sampleEmitter(uSelect, uPoint, es)) {
-                const MeshTriangle& lt = m_mesh.triangle(es.prim);
-                const Material& lm = m_scene.materials[lt.material];
-                const glm::vec3 toLight = es.p - sp.p;
-                const float dist2 = glm::dot(toLight, toLight);
-                const float dist = std::sqrt(dist2);
-                const glm::vec3 wi = toLight / dist;
-                const float cosL = glm::dot(lt.n, -wi);
-                const float cosTheta = glm::dot(sp.n, wi);
-                const bool emitsToX = lm.doubleSided ? cosL != 0.0f : cosL > 0.0f;
-                if (dist2 > 0.0f && emitsToX && cosTheta > 0.0f && glm::dot(sp.ng, wi) > 0.0f) {
-                    const glm::vec2 uvL = triangleUv(m_scene, lt, es.bary);
-                    const glm::vec3 le = isCutOut(lm, m_textures, uvL)
-                                             ? glm::vec3(0.0f)
-                                             : lookupEmission(lm, m_textures, uvL);
-                    const glm::vec3 f = bsdf.eval(wo, wi);
-                    if (!isBlack(le) && !isBlack(f)) {
-                        const float pdfLight = es.pdfArea * dist2 / std::abs(cosL);
-                        const float w = estimator == Estimator::Mis
-                                            ? powerHeuristic(pdfLight, bsdf.pdf(wo, wi))
-                                            : 1.0f;
-                        const glm::vec3 target =
-                            offsetRayOrigin(es.p, cosL > 0.0f ? lt.n : -lt.n, m_offsetScale);
-                        const glm::vec3 dir = target - origin;
-                        ++counters.shadowRays;
-                        if (sink) sink->push_back({origin, dir, 0.0f, kShadowTFar, true});
-                        if (!m_mesh.occluded(origin, dir, 0.0f, kShadowTFar))
-                            Lk += beta * f * le * (cosTheta * w / pdfLight);
-                    }
+            const bool emitsToX = lm.doubleSided ? cosL != 0.0f : cosL > 0.0f;
+            if (dist2 > 0.0f && emitsToX && cosTheta > 0.0f && glm::dot(sp.ng, wi) > 0.0f) {
+                const glm::vec2 uvL = triangleUv(m_scene, lt, es.bary);
+                const glm::vec3 le = isCutOut(lm, m_textures, uvL)
+                                         ? glm::vec3(0.0f)
+                                         : lookupEmission(lm, m_textures, uvL);
+                const glm::vec3 f = bsdf.eval(wo, wi);
+                if (!isBlack(le) && !isBlack(f)) {
+                    const float pdfLight = es.pdfArea * dist2 / std::abs(cosL);
+                    const float w = estimator == Estimator::Mis
+                                        ? powerHeuristic(pdfLight, bsdf.pdf(wo, wi))
+                                        : 1.0f;
+                    const glm::vec3 target =
+                        offsetRayOrigin(es.p, cosL > 0.0f ? lt.n : -lt.n, m_offsetScale);
+                    shadows.push_back({origin, target - origin, kShadowTFar,
+                                       beta * f * le * (cosTheta * w / pdfLight), p.slot, layer});
                 }
             }
         }
-
-        // The last vertex only traces on if a BSDF-sampled emitter hit can still add light
-        if (k == lastVertex && !useBsdfHits) break;
-
-        // Sample the BSDF for the next vertex
-        const float uLobe = sampler.get1D();
-        const glm::vec2 uDir = sampler.get2D();
-        BsdfSample bs;
-        if (!bsdf.sample(wo, uLobe, uDir, bs)) break;
-        const float cosTheta = glm::dot(sp.n, bs.wi);
-        if (cosTheta <= 0.0f || glm::dot(sp.ng, bs.wi) <= 0.0f || isBlack(bs.f)) break;
-        beta *= bs.f * (cosTheta / bs.pdf);
-        prevBsdfPdf = bs.pdf;
-
-        // Russian roulette on the continuation from vertex k (bounce k) if enabled
-        if (m_settings.rouletteStartBounce >= 0 && k > m_settings.rouletteStartBounce) {
-            const float uRr = sampler.get1D();
-            const float survive = std::min(1.0f, maxComponent(beta));
-            if (!(uRr < survive)) break;
-            beta /= survive;
-        }
-
-        rayO = origin;
-        rayD = bs.wi;
-        found = m_mesh.intersect(rayO, rayD, 0.0f, kInfinity, hit);
-        ++counters.bounceRays;
-        if (sink) sink->push_back({rayO, rayD, 0.0f, kInfinity, false});
     }
 
-    glm::vec3 full(0.0f);
-    for (int l = int(Layer::Emission); l < kLayerCount; ++l)
-        full += out.L[l];
-    out.L[int(Layer::Full)] = full;
+    // The last vertex only traces on if a BSDF-sampled emitter hit can still add light
+    if (k == lastVertex && !useBsdfHits) return false;
+
+    // Sample the BSDF for the next vertex
+    const float uLobe = p.sampler.get1D();
+    const glm::vec2 uDir = p.sampler.get2D();
+    BsdfSample bs;
+    if (!bsdf.sample(wo, uLobe, uDir, bs)) return false;
+    const float cosTheta = glm::dot(sp.n, bs.wi);
+    if (cosTheta <= 0.0f || glm::dot(sp.ng, bs.wi) <= 0.0f || isBlack(bs.f)) return false;
+    p.beta *= bs.f * (cosTheta / bs.pdf);
+    p.prevBsdfPdf = bs.pdf;
+
+    // Russian roulette on the continuation from vertex k (bounce k) if enabled: survival
+    // probability min(1, max component of the throughput / threshold), so only paths whose
+    // throughput fell below the threshold are thinned (docs/reference.md, "Russian roulette")
+    if (m_settings.rouletteStartBounce >= 0 && k > m_settings.rouletteStartBounce) {
+        const float uRr = p.sampler.get1D();
+        const float survive = std::min(1.0f, maxComponent(p.beta) / m_settings.rouletteThreshold);
+        if (!(uRr < survive)) return false;
+        p.beta /= survive;
+    }
+
+    p.rayO = origin;
+    p.rayD = bs.wi;
+    p.vertex = k + 1;
+    return true;
+}
+
+void Integrator::traceClosest(std::vector<PathState>& paths, const std::vector<uint32_t>& active,
+                              bool packets, bool coherent) const {
+    if (!packets) {
+        for (uint32_t i : active) {
+            PathState& p = paths[i];
+            p.found = m_mesh.intersect(p.rayO, p.rayD, 0.0f, kInfinity, p.hit);
+        }
+        return;
+    }
+    for (size_t first = 0; first < active.size(); first += 16) {
+        const int n = int(std::min<size_t>(16, active.size() - first));
+        glm::vec3 o[16], d[16];
+        RayHit hits[16];
+        for (int j = 0; j < n; ++j) {
+            o[j] = paths[active[first + size_t(j)]].rayO;
+            d[j] = paths[active[first + size_t(j)]].rayD;
+        }
+        m_mesh.intersect16(n, o, d, kInfinity, hits, coherent);
+        for (int j = 0; j < n; ++j) {
+            PathState& p = paths[active[first + size_t(j)]];
+            p.found = hits[j].prim != ~0u;
+            p.hit = hits[j];
+        }
+    }
+}
+
+void Integrator::traceShadows(const std::vector<ShadowRay>& shadows, std::vector<RTCRay>& stream,
+                              PathRadiance* out, bool packets) const {
+    // Unoccluded rays add their light in queue order: per path, the order of tracing it alone
+    if (!packets) {
+        for (const ShadowRay& s : shadows)
+            if (!m_mesh.occluded(s.o, s.d, 0.0f, s.tFar)) out[s.slot].L[s.layer] += s.contribution;
+        return;
+    }
+    // One rtcOccluded1M stream over the whole queue (measured fastest for shadow rays)
+    stream.resize(shadows.size());
+    for (size_t i = 0; i < shadows.size(); ++i) {
+        const ShadowRay& s = shadows[i];
+        RTCRay& r = stream[i];
+        r.org_x = s.o.x;
+        r.org_y = s.o.y;
+        r.org_z = s.o.z;
+        r.tnear = 0.0f;
+        r.dir_x = s.d.x;
+        r.dir_y = s.d.y;
+        r.dir_z = s.d.z;
+        r.time = 0.0f;
+        r.tfar = s.tFar;
+        r.mask = ~0u;
+        r.id = unsigned(i);
+        r.flags = 0;
+    }
+    m_mesh.occludedStream(stream);
+    for (size_t i = 0; i < shadows.size(); ++i)
+        if (!(stream[i].tfar < 0.0f))
+            out[shadows[i].slot].L[shadows[i].layer] += shadows[i].contribution;
+}
+
+void Integrator::prefetchTriangle(const PathState& p) const {
+    if (!p.found) return;
+    const char* t = reinterpret_cast<const char*>(&m_mesh.triangle(p.hit.prim));
+    __builtin_prefetch(t);
+    __builtin_prefetch(t + sizeof(MeshTriangle) - 1);
+}
+
+void Integrator::prefetchVertices(const PathState& p) const {
+    if (!p.found) return;
+    const MeshTriangle& tri = m_mesh.triangle(p.hit.prim);
+    for (uint32_t v : tri.v)
+        __builtin_prefetch(&m_scene.vertices[v]);
+}
+
+void Integrator::prefetchTexels(const PathState& p) const {
+    if (!p.found) return;
+    const MeshTriangle& tri = m_mesh.triangle(p.hit.prim);
+    const int texture = m_scene.materials[tri.material].baseColorTexture;
+    if (texture >= 0) m_textures.prefetch(texture, triangleUv(m_scene, tri, {p.hit.u, p.hit.v}));
+}
+
+void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool packets,
+                            PathCounters& counters, std::vector<RecordedRay>* sink,
+                            WaveScratch& scratch) const {
+    for (const PathState& p : paths)
+        for (glm::vec3& l : out[p.slot].L)
+            l = glm::vec3(0.0f);
+    std::vector<uint32_t>& active = scratch.active;
+    std::vector<uint32_t>& next = scratch.next;
+    std::vector<ShadowRay>& shadows = scratch.shadows;
+    active.resize(paths.size());
+    for (size_t i = 0; i < paths.size(); ++i)
+        active[i] = uint32_t(i);
+
+    for (bool cameraRays = true; !active.empty(); cameraRays = false) {
+        // 1. The closest hits of every live path's ray (camera rays are coherent)
+        traceClosest(paths, active, packets, cameraRays);
+        (cameraRays ? counters.cameraRays : counters.bounceRays) += active.size();
+        if (sink)
+            for (uint32_t i : active)
+                sink->push_back({paths[i].rayO, paths[i].rayD, 0.0f, kInfinity, false});
+
+        // 2. Shade every hit; the paths that go on form the next wave, in order
+        // Hits are random accesses into the mesh and textures: prefetch, a wave at a time, the
+        // triangles, then their vertices (they need the triangles' indices), then the
+        // base-colour texels (they need the vertices' uvs), so shading finds them in cache.
+        for (uint32_t i : active)
+            prefetchTriangle(paths[i]);
+        for (uint32_t i : active)
+            prefetchVertices(paths[i]);
+        for (uint32_t i : active)
+            prefetchTexels(paths[i]);
+        shadows.clear();
+        next.clear();
+        for (uint32_t i : active) {
+            PathState& p = paths[i];
+            if (p.found && shade(p, out[p.slot], shadows)) next.push_back(i);
+        }
+
+        // 3. Shadow rays of this depth
+        counters.shadowRays += shadows.size();
+        if (sink)
+            for (const ShadowRay& s : shadows)
+                sink->push_back({s.o, s.d, 0.0f, s.tFar, true});
+        traceShadows(shadows, scratch.shadowRays, out, packets);
+        active.swap(next);
+    }
+
+    for (const PathState& p : paths) {
+        PathRadiance& r = out[p.slot];
+        glm::vec3 full(0.0f);
+        for (int l = int(Layer::Emission); l < kLayerCount; ++l)
+            full += r.L[l];
+        r.L[int(Layer::Full)] = full;
+    }
 }
 
 }  // namespace gilab::ref

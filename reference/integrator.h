@@ -10,6 +10,11 @@
  * and by its BSDF-sampled ray hitting an emitter at vertex k + 1 (unless NeeOnly); under Mis
  * the two emitter estimates are weighted by the power heuristic (Veach 1997 §9.2).
  * maxBounces = B: light arriving at vertices k <= B + 1 only.
+ *
+ * Paths are traced as a wavefront (docs/reference.md, "Wavefront"): all live paths' rays of one
+ * depth go to Embree in 16-wide packets, then every hit is shaded (queuing its shadow rays),
+ * then all shadow rays are traced in packets and the unoccluded ones add their light. Each
+ * path's arithmetic and random numbers are those of tracing it alone, in the same order.
  */
 #include <cstdint>
 #include <vector>
@@ -17,14 +22,14 @@
 #include <glm/glm.hpp>
 
 #include "core/scene/camera.h"
+#include "reference/embree_scene.h"
 #include "reference/path_tracer.h"
+#include "reference/sampling.h"
 
 namespace gilab::ref {
 
 class LightSampler;
-class Sampler;
 class TextureLookup;
-struct RayHit;
 
 /** Radiance of one camera path per layer (index = Layer); Full = the sum of the others. */
 struct PathRadiance {
@@ -37,20 +42,65 @@ struct PathCounters {
     uint64_t shadowRays = 0;
 };
 
+/** One path in flight: its next ray, throughput and random-number stream. */
+struct PathState {
+    Sampler sampler;
+    glm::vec3 rayO{0.0f};
+    glm::vec3 rayD{0.0f, 0.0f, 1.0f};  // unit
+    glm::vec3 beta{1.0f};
+    float prevBsdfPdf = 0.0f;  // solid-angle pdf of the ray that leads to `vertex`
+    int vertex = 1;            // the surface vertex the current ray hits
+    uint32_t slot = 0;         // index of this path's PathRadiance
+    RayHit hit;
+    bool found = false;
+};
+
+/** A shadow ray of one vertex and the light it adds to `slot`'s layer if unoccluded. */
+struct ShadowRay {
+    glm::vec3 o;
+    glm::vec3 d;
+    float tFar;
+    glm::vec3 contribution;
+    uint32_t slot;
+    int layer;
+};
+
+/** Per-thread buffers of tracePaths (reused between calls). */
+struct WaveScratch {
+    std::vector<uint32_t> active, next;
+    std::vector<ShadowRay> shadows;
+    std::vector<RTCRay> shadowRays;  // the stream handed to rtcOccluded1M
+};
+
 class Integrator {
 public:
     Integrator(const Scene& scene, const ReferenceSettings& settings, const EmbreeScene& mesh,
                const LightSampler& lights, const TextureLookup& textures);
 
     /**
-     * Traces one path from the camera ray `ray` (unit direction). `cameraHit`: the camera
-     * ray's closest hit when already traced (packets; prim == ~0u for a miss), or nullptr to
-     * trace it here. `sink` receives every ray traced (benchmarks), or nullptr.
+     * Traces every path from its camera ray (rayO, rayD set, vertex = 1) to its end; out[slot]
+     * receives the path's radiance per layer. `packets`: rtcIntersect16/rtcOccluded16 (default)
+     * or one rtcIntersect1/rtcOccluded1 per ray (benchmarks; the same estimator). `sink`
+     * receives every ray traced (benchmarks), or nullptr.
      */
-    void radiance(const Ray& ray, const RayHit* cameraHit, Sampler& sampler, PathRadiance& out,
-                  PathCounters& counters, std::vector<RecordedRay>* sink) const;
+    void tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool packets,
+                    PathCounters& counters, std::vector<RecordedRay>* sink,
+                    WaveScratch& scratch) const;
 
 private:
+    /** Shades path p's hit: emission, NEE (queued on `shadows`), BSDF sampling of the next
+     *  ray. Returns whether the path goes on. */
+    bool shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& shadows) const;
+
+    void prefetchTriangle(const PathState& p) const;
+    void prefetchVertices(const PathState& p) const;
+    void prefetchTexels(const PathState& p) const;
+
+    void traceClosest(std::vector<PathState>& paths, const std::vector<uint32_t>& active,
+                      bool packets, bool coherent) const;
+    void traceShadows(const std::vector<ShadowRay>& shadows, std::vector<RTCRay>& stream,
+                      PathRadiance* out, bool packets) const;
+
     const Scene& m_scene;
     const ReferenceSettings& m_settings;
     const EmbreeScene& m_mesh;
@@ -59,9 +109,9 @@ private:
     float m_offsetScale = 1.0f;  // offsetRayOrigin originScale of this scene
 };
 
-/** Camera rays in rtcIntersect16 packets of 4 x 4 pixels (default) or one rtcIntersect1 per
- *  path; for benchmarks (docs/reference.md, "Throughput"). Not thread-safe with rendering. */
-void setCameraPackets(bool enabled);
+/** All rays in 16-wide packets (default) or one Embree call per ray; for benchmarks
+ *  (docs/reference.md, "Throughput"). Not thread-safe with rendering. */
+void setRayPackets(bool enabled);
 
 /** The layer light arriving at surface vertex k (>= 1) belongs to. */
 inline Layer layerForVertex(int k) {

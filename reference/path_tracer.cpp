@@ -7,6 +7,7 @@
 #include <limits>
 #include <sstream>
 
+#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
@@ -29,14 +30,17 @@ glm::vec2 pixelOffset(Sampler& sampler, PixelFilter filter) {
 }
 
 constexpr int kTileSize = 8;
-constexpr int kPacketSize = 4;  // camera rays of a 4 x 4 pixel block share one rtcIntersect16
+constexpr int kPacketSize = 4;   // camera rays of a 4 x 4 pixel block share one rtcIntersect16
+constexpr int kWaveSamples = 4;  // samples per pixel traced together as one wavefront
 constexpr int kValuesPerPixel = kLayerCount * 3;
 
-std::atomic<bool> g_cameraPackets{true};
+std::atomic<bool> g_rayPackets{true};
 
 void validate(const Scene& scene, const ReferenceSettings& s) {
     if (s.maxBounces < 0) throw Error("reference: maxBounces must be >= 0");
     if (s.rouletteStartBounce < -1) throw Error("reference: rouletteStartBounce must be >= -1");
+    if (!(s.rouletteThreshold > 0.0f && s.rouletteThreshold <= 1.0f))
+        throw Error("reference: roulette_threshold must be in (0, 1]");
     if (s.batchSamples < 1) throw Error("reference: batchSamples must be >= 1");
     if (scene.settings.width < 1 || scene.settings.height < 1)
         throw Error("scene '" + scene.name + "': invalid resolution");
@@ -52,8 +56,8 @@ void validate(const Scene& scene, const ReferenceSettings& s) {
 
 }  // namespace
 
-void setCameraPackets(bool enabled) {
-    g_cameraPackets = enabled;
+void setRayPackets(bool enabled) {
+    g_rayPackets = enabled;
 }
 
 const char* layerName(Layer layer) {
@@ -76,6 +80,10 @@ const char* layerName(Layer layer) {
 
 const char* pixelFilterName(PixelFilter f) {
     return f == PixelFilter::Center ? "center" : "box";
+}
+
+const char* samplerKindName(SamplerKind k) {
+    return k == SamplerKind::Sobol ? "sobol" : "independent";
 }
 
 const char* estimatorName(Estimator e) {
@@ -113,6 +121,14 @@ struct PathTracer::Impl {
     const Integrator integrator;
     RayStats stats;
     std::vector<RecordedRay>* sink = nullptr;
+    /** Per-thread wavefront buffers, reused across tiles and calls. */
+    struct TileScratch {
+        std::vector<PathState> paths;
+        std::vector<int> pathPixel;  // tile pixel of each path
+        std::vector<PathRadiance> radiance;
+        WaveScratch wave;
+    };
+    tbb::enumerable_thread_specific<TileScratch> scratch;
     std::vector<double> scratchSum, scratchSumSq;
 };
 
@@ -154,50 +170,35 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
             }
     };
 
+    // Waves of kWaveSamples samples of every tile pixel; within a sample, 4 x 4 pixel blocks
+    // (one camera-ray packet each). Each pixel still receives its samples in index order.
     const Camera& camera = scene.camera;
-    PathRadiance radiance;
-    if (!packets) {
-        for (int p = 0; p < pixels; ++p) {
-            const int x = x0 + p % tw, y = y0 + p / tw;
-            const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
-            for (uint64_t s = first; s < first + count; ++s) {
-                Sampler sampler(settings.seed, pixelIndex, s);
-                const glm::vec2 u = pixelOffset(sampler, settings.pixelFilter);
-                const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
-                integrator.radiance(ray, nullptr, sampler, radiance, counters, sink);
-                add(p, radiance);
-            }
-        }
-    } else {
-        // Samples outermost: each pixel still receives its samples in index order
-        for (uint64_t s = first; s < first + count; ++s) {
-            for (int by = y0; by < y1; by += kPacketSize) {
-                for (int bx = x0; bx < x1; bx += kPacketSize) {
-                    Sampler samplers[16];
-                    glm::vec3 o[16], d[16];
-                    int tilePixel[16];
-                    int n = 0;
+    TileScratch& ws = scratch.local();
+    std::vector<PathState>& paths = ws.paths;
+    std::vector<int>& pathPixel = ws.pathPixel;
+    for (uint64_t s0 = first; s0 < first + count; s0 += kWaveSamples) {
+        const uint64_t s1 = std::min<uint64_t>(first + count, s0 + kWaveSamples);
+        paths.clear();
+        pathPixel.clear();
+        for (uint64_t s = s0; s < s1; ++s)
+            for (int by = y0; by < y1; by += kPacketSize)
+                for (int bx = x0; bx < x1; bx += kPacketSize)
                     for (int y = by; y < std::min(by + kPacketSize, y1); ++y)
                         for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x) {
                             const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
-                            samplers[n] = Sampler(settings.seed, pixelIndex, s);
-                            const glm::vec2 u = pixelOffset(samplers[n], settings.pixelFilter);
+                            PathState& path = paths.emplace_back();
+                            path.sampler = Sampler(settings.seed, pixelIndex, s, settings.sampler);
+                            const glm::vec2 u = pixelOffset(path.sampler, settings.pixelFilter);
                             const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
-                            o[n] = ray.origin;
-                            d[n] = ray.direction;
-                            tilePixel[n] = (y - y0) * tw + (x - x0);
-                            ++n;
+                            path.rayO = ray.origin;
+                            path.rayD = ray.direction;
+                            path.slot = uint32_t(paths.size() - 1);
+                            pathPixel.push_back((y - y0) * tw + (x - x0));
                         }
-                    RayHit hits[16];
-                    mesh.intersect16(n, o, d, std::numeric_limits<float>::infinity(), hits);
-                    for (int i = 0; i < n; ++i) {
-                        integrator.radiance({o[i], d[i]}, &hits[i], samplers[i], radiance, counters,
-                                            sink);
-                        add(tilePixel[i], radiance);
-                    }
-                }
-            }
-        }
+        ws.radiance.resize(paths.size());
+        integrator.tracePaths(paths, ws.radiance.data(), packets, counters, sink, ws.wave);
+        for (size_t i = 0; i < paths.size(); ++i)
+            add(pathPixel[i], ws.radiance[i]);
     }
 
     for (int p = 0; p < pixels; ++p) {
@@ -233,7 +234,7 @@ bool PathTracer::addSamples(Accumulator& acc, uint32_t count, const std::atomic<
     const int tilesX = (w + kTileSize - 1) / kTileSize, tilesY = (h + kTileSize - 1) / kTileSize;
     const int tileCount = tilesX * tilesY;
     const uint64_t first = acc.samples;
-    const bool packets = g_cameraPackets.load();
+    const bool packets = g_rayPackets.load();
     std::atomic<bool> cancelled{false};
     std::atomic<uint64_t> cameraRays{0}, bounceRays{0}, shadowRays{0}, nonFinite{0};
     auto runTile = [&](int t) {
@@ -302,12 +303,17 @@ std::string PathTracer::toString() const {
         << "max_bounces: " << s.maxBounces << "\n"
         << "roulette_start_bounce: " << s.rouletteStartBounce
         << (s.rouletteStartBounce < 0 ? " (off)" : "") << "\n"
+        << "roulette_threshold: " << s.rouletteThreshold
+        << " (survival min(1, max(throughput) / threshold))\n"
         << "seed: " << s.seed << "\n"
         << "pixel filter: " << pixelFilterName(s.pixelFilter) << "\n"
         << "batch_samples: " << s.batchSamples << " (does not change the image)\n"
         << "ray_offsets: 256 ulps along the geometric normal; fixed step near the origin scaled by "
            "min(1, scene magnitude)\n"
-        << "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
+        << (s.sampler == SamplerKind::Independent
+                ? "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
+                : "rng: sobol, Owen-scrambled (0,2)-sequence per 1D/2D draw, shuffled index "
+                  "(Burley 2020), seeds from SplitMix64 of (seed, pixel, draw)\n")
         << "punctual_lights: " << im.lights.punctualCount() << ", all evaluated at every vertex\n"
         << "emissive_triangles: " << im.lights.emitterCount()
         << ", one sample per vertex by luminance power, uniform on the triangle\n"

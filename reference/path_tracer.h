@@ -28,6 +28,7 @@
 
 #include "core/image/image.h"
 #include "core/scene/scene.h"
+#include "reference/sampling.h"
 
 namespace gilab::ref {
 
@@ -49,17 +50,21 @@ enum class PixelFilter { Box, Center };
 const char* pixelFilterName(PixelFilter f);  // "box", "center"
 
 /** Bumped whenever a change alters the images; part of every reference cache key. */
-inline constexpr int kRendererVersion = 2;  // 2: scale-aware ray offsets (issue 15)
+inline constexpr int kRendererVersion = 3;  // 3: roulette by default, wavefront (issue 16)
 
 struct ReferenceSettings {
     /** Indirect bounces computed: 0 = emission + direct only; paths have at most
      *  maxBounces + 1 surface vertices. */
     int maxBounces = 32;
-    /** Russian roulette on bounces > this (unbiased, adds noise); -1 = off (default). */
-    int rouletteStartBounce = -1;
+    /** Russian roulette on the continuation from vertices k > this (unbiased); -1 = off. */
+    int rouletteStartBounce = 4;
+    /** Roulette survival probability: min(1, max component of the throughput / this). */
+    float rouletteThreshold = 0.05f;
     Estimator estimator = Estimator::Mis;
     uint64_t seed = 1;
     PixelFilter pixelFilter = PixelFilter::Box;
+    /** Independent uniforms (default) or Owen-scrambled Sobol (docs/reference.md, "Samplers"). */
+    SamplerKind sampler = SamplerKind::Independent;
     /** Samples added per pass over the image; the stop criteria are checked between passes. */
     uint32_t batchSamples = 4;
 };

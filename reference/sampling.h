@@ -4,9 +4,9 @@
  *
  * Every random number is a pure function of (seed, pixel, sample index, dimension): a
  * counter-based hash, so a sample is the same whichever thread renders it and whenever it is
- * rendered (docs/reference.md, "Determinism"). The numbers are independent uniform variates,
- * not a low-discrepancy sequence: the per-pixel standard errors the Accumulator reports assume
- * i.i.d. samples, which stratified or QMC points would break.
+ * rendered (docs/reference.md, "Determinism"). By default the numbers are independent uniform
+ * variates, which the per-pixel standard errors of the Accumulator assume; the Owen-scrambled
+ * Sobol sampler converges faster but makes those standard errors conservative (too large).
  */
 #include <bit>
 #include <cmath>
@@ -34,32 +34,119 @@ inline float toUnitFloat(uint64_t h) {
     return float(uint32_t(h >> 40)) * 0x1p-24f;
 }
 
+inline uint32_t reverseBits32(uint32_t x) {
+    x = (x << 16) | (x >> 16);
+    x = ((x & 0x00ff00ffu) << 8) | ((x & 0xff00ff00u) >> 8);
+    x = ((x & 0x0f0f0f0fu) << 4) | ((x & 0xf0f0f0f0u) >> 4);
+    x = ((x & 0x33333333u) << 2) | ((x & 0xccccccccu) >> 2);
+    return ((x & 0x55555555u) << 1) | ((x & 0xaaaaaaaau) >> 1);
+}
+
 /**
- * Counter-based sampler of one (seed, pixel, sample): dimension d gives
- * mix64(key ^ (d + 1) * golden), key = mix64(mix64(mix64(seed) ^ pixel) ^ sample).
- * Dimensions are consumed in a fixed order along the path, so the stream is reproducible.
+ * A nested uniform (Owen) scramble of the 32 bits of x, most significant first, keyed by seed:
+ * each bit is flipped by a function of the seed and the bits above it only. Burley 2020,
+ * "Practical Hash-based Owen Scrambling" (JCGT 9(4)), §3-4: bit-reverse, a Laine–Karras
+ * style hash whose multiplications only carry lower bits into higher ones, reverse back.
+ */
+inline uint32_t owenScramble(uint32_t x, uint32_t seed) {
+    x = reverseBits32(x);
+    x += seed;
+    x ^= x * 0x6c50b47cu;
+    x ^= x * 0xb82f1e52u;
+    x ^= x * 0xc7afe638u;
+    x ^= x * 0x8d22f6e6u;
+    return reverseBits32(x);
+}
+
+/** The first two Sobol dimensions as 32-bit fractions: van der Corput, and the dimension of
+ *  primitive polynomial x + 1 (direction numbers v_1 = 1/2, v_{j+1} = v_j xor v_j / 2). */
+inline uint32_t sobolDimension0(uint32_t i) {
+    return reverseBits32(i);
+}
+inline uint32_t sobolDimension1(uint32_t i) {
+    uint32_t x = 0;
+    for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
+        if (i & 1u) x ^= v;
+    return x;
+}
+
+/** How the sampler makes its numbers (docs/reference.md, "Samplers"). */
+enum class SamplerKind { Independent, Sobol };
+const char* samplerKindName(SamplerKind k);  // "independent", "sobol"
+
+/**
+ * Counter-based sampler of one (seed, pixel, sample). Every number is a pure function of
+ * (seed, pixel, sample index, dimension), consumed in a fixed order along the path, so a sample
+ * is the same whichever thread renders it and whenever it is rendered.
+ *  - Independent: dimension d gives mix64(key ^ (d + 1) * golden),
+ *    key = mix64(mix64(mix64(seed) ^ pixel) ^ sample): i.i.d. uniforms.
+ *  - Sobol: each get1D / get2D call is one "pad" (Burley 2020 §5): the pixel's samples of that
+ *    call form an Owen-scrambled (0, 2)-sequence in base 2 (Sobol dimensions 0 and 1; 1D calls
+ *    use dimension 0), with the sample index itself Owen-scrambled per call so pads are
+ *    decorrelated. Seeds are hashes of (seed, pixel, call).
  */
 class Sampler {
 public:
     Sampler() = default;
-    Sampler(uint64_t seed, uint64_t pixel, uint64_t sampleIndex)
-        : m_key(mix64(mix64(mix64(seed + 0x632be59bd9b4e019ull) ^ pixel) ^ sampleIndex)) {}
+    Sampler(uint64_t seed, uint64_t pixel, uint64_t sampleIndex,
+            SamplerKind kind = SamplerKind::Independent)
+        : m_kind(kind) {
+        const uint64_t pixelKey = mix64(mix64(seed + 0x632be59bd9b4e019ull) ^ pixel);
+        m_key = mix64(pixelKey ^ sampleIndex);
+        if (kind == SamplerKind::Sobol) {
+            // Indices beyond 2^32 start a new scrambled sequence
+            m_sequenceKey =
+                sampleIndex >> 32 == 0 ? pixelKey : mix64(pixelKey ^ (sampleIndex >> 32));
+            m_index = uint32_t(sampleIndex);
+        }
+    }
 
-    float get1D() { return toUnitFloat(mix64(m_key ^ (uint64_t(++m_dimension) * kGolden))); }
+    float get1D() {
+        if (!sobolDraw()) return toUnitFloat(nextHash());
+        const uint64_t h = nextPadHash();
+        const uint32_t x = owenScramble(sobolDimension0(shuffledIndex(h)), uint32_t(h >> 32));
+        return float(x >> 8) * 0x1p-24f;
+    }
     /** 53-bit uniform in [0, 1), for choices among millions of items (light selection). */
     double get1DDouble() {
-        return double(mix64(m_key ^ (uint64_t(++m_dimension) * kGolden)) >> 11) * 0x1p-53;
+        if (!sobolDraw()) return double(nextHash() >> 11) * 0x1p-53;
+        const uint64_t h = nextPadHash();
+        const uint32_t x = owenScramble(sobolDimension0(shuffledIndex(h)), uint32_t(h >> 32));
+        const uint64_t low = mix64(h) >> 43;  // 21 random low bits below the 32 stratified ones
+        return double((uint64_t(x) << 21) | low) * 0x1p-53;
     }
     glm::vec2 get2D() {
-        const float a = get1D();
-        return {a, get1D()};
+        if (!sobolDraw()) {
+            const float a = toUnitFloat(nextHash());
+            return {a, toUnitFloat(nextHash())};
+        }
+        const uint64_t h = nextPadHash();
+        const uint32_t i = shuffledIndex(h);
+        const uint64_t h2 = mix64(h);
+        const uint32_t x = owenScramble(sobolDimension0(i), uint32_t(h >> 32));
+        const uint32_t y = owenScramble(sobolDimension1(i), uint32_t(h2 >> 32));
+        return {float(x >> 8) * 0x1p-24f, float(y >> 8) * 0x1p-24f};
     }
     uint32_t dimension() const { return m_dimension; }
 
 private:
+    /** Whether the next draw is a Sobol pad: the first kSobolDraws draws of a path (the camera
+     *  ray's pixel position, then the first vertex's light and BSDF draws), where stratification
+     *  pays; later draws are i.i.d. hashes, which cost less (measured: docs/reference.md). */
+    bool sobolDraw() const { return m_kind == SamplerKind::Sobol && m_dimension < kSobolDraws; }
+
+    static constexpr uint32_t kSobolDraws = 6;
+    /** The next draw's hash: of the sample (i.i.d. draws) or of the pixel's sequence (pads). */
+    uint64_t nextHash() { return mix64(m_key ^ (uint64_t(++m_dimension) * kGolden)); }
+    uint64_t nextPadHash() { return mix64(m_sequenceKey ^ (uint64_t(++m_dimension) * kGolden)); }
+    uint32_t shuffledIndex(uint64_t h) const { return owenScramble(m_index, uint32_t(h)); }
+
     static constexpr uint64_t kGolden = 0x9e3779b97f4a7c15ull;
-    uint64_t m_key = 0;
+    uint64_t m_key = 0;          // of (seed, pixel, sample)
+    uint64_t m_sequenceKey = 0;  // of (seed, pixel): every sample of the pixel shares the pads
     uint32_t m_dimension = 0;
+    uint32_t m_index = 0;
+    SamplerKind m_kind = SamplerKind::Independent;
 };
 
 /** Orthonormal basis around a unit z axis (Duff et al. 2017, "Building an Orthonormal Basis,

@@ -25,7 +25,7 @@ static_assert(sizeof(Material) == sizeof(std::string) + 64,
               "Material changed: update hashMaterial()");
 static_assert(sizeof(Texture) == sizeof(std::string) + sizeof(std::vector<uint8_t>) + 24,
               "Texture changed: update hashTexture()");
-static_assert(sizeof(ReferenceSettings) == 32, "ReferenceSettings changed: update the key");
+static_assert(sizeof(ReferenceSettings) == 40, "ReferenceSettings changed: update the key");
 static_assert(std::endian::native == std::endian::little, "hashes assume little-endian data");
 
 std::string toHex(XXH128_hash_t h) {
@@ -199,9 +199,11 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
     h.tag("settings");  // batchSamples does not change the image (determinism contract)
     h.i32(settings.maxBounces);
     h.i32(settings.rouletteStartBounce);
+    h.u64(std::bit_cast<uint32_t>(settings.rouletteThreshold));
     h.i32(int32_t(settings.estimator));
     h.u64(settings.seed);
     h.i32(int32_t(settings.pixelFilter));
+    h.i32(int32_t(settings.sampler));
     h.tag("scene_data");
     h.str(dataHash);
 
@@ -225,9 +227,11 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
         {"settings",
          {{"max_bounces", settings.maxBounces},
           {"roulette_start_bounce", settings.rouletteStartBounce},
+          {"roulette_threshold", settings.rouletteThreshold},
           {"estimator", estimatorName(settings.estimator)},
           {"seed", settings.seed},
-          {"pixel_filter", pixelFilterName(settings.pixelFilter)}}},
+          {"pixel_filter", pixelFilterName(settings.pixelFilter)},
+          {"sampler", samplerKindName(settings.sampler)}}},
         {"scene_data_xxh3_128", dataHash},
         {"scene_data",
          {{"vertices", scene.vertices.size()},

@@ -75,6 +75,16 @@ glm::vec4 TextureLookup::fetch(const Decoded& d, int x, int y) const {
     return {table[p[0]], table[p[1]], table[p[2]], m_linearTable[p[3]]};
 }
 
+void TextureLookup::prefetch(int texture, glm::vec2 uv) const {
+    const Decoded& d = m_textures[size_t(texture)];
+    if (!std::isfinite(uv.x) || !std::isfinite(uv.y)) return;
+    const glm::vec2 st = glm::floor(uv * glm::vec2(float(d.width), float(d.height)) - 0.5f);
+    const int x = wrapCoord(int(std::clamp(st.x, -4194304.0f, 4194304.0f)), d.width, d.wrapU);
+    const int y0 = int(std::clamp(st.y, -4194304.0f, 4194304.0f));
+    for (int y : {wrapCoord(y0, d.height, d.wrapV), wrapCoord(y0 + 1, d.height, d.wrapV)})
+        __builtin_prefetch(d.rgba + (size_t(y) * size_t(d.width) + size_t(x)) * 4);
+}
+
 glm::vec4 TextureLookup::sample(int texture, glm::vec2 uv) const {
     const Decoded& d = m_textures[size_t(texture)];
     if (!std::isfinite(uv.x)) uv.x = 0.0f;

@@ -22,6 +22,8 @@ public:
 
     /** scene.glsl sceneBilinear() at mip 0: bilinear filtering of the decoded texels. */
     glm::vec4 sample(int texture, glm::vec2 uv) const;
+    /** Prefetches the texels sample(texture, uv) will read (a hint; no effect on results). */
+    void prefetch(int texture, glm::vec2 uv) const;
     /** Mean of the decoded mip-0 texels (used to weight texture-emissive triangles). */
     glm::vec4 average(int texture) const { return m_textures[size_t(texture)].mean; }
     size_t count() const { return m_textures.size(); }

@@ -216,10 +216,11 @@ std::vector<double> furnaceExpected(double rho, int maxBounces) {
 }
 
 void checkFurnace(float rho, Estimator estimator, int maxBounces, uint32_t spp,
-                  int rouletteStart = -1) {
+                  int rouletteStart = -1, SamplerKind sampler = SamplerKind::Independent) {
     const float le = 0.75f;
     ReferenceSettings st = settingsWith(estimator, maxBounces);
     st.rouletteStartBounce = rouletteStart;
+    st.sampler = sampler;
     const Accumulator acc = render(furnaceScene(rho, le), st, spp);
     const std::vector<double> expected = furnaceExpected(rho, maxBounces);
     for (int l = 0; l < kLayerCount; ++l) {
@@ -252,6 +253,18 @@ TEST(CpuReferenceFurnace, ConvergesToLeOverOneMinusRho) {
 
 TEST(CpuReferenceFurnace, RussianRouletteIsUnbiased) {
     checkFurnace(0.8f, Estimator::Mis, 12, 2048, 1);
+}
+
+TEST(CpuReferenceFurnace, DefaultRouletteIsUnbiasedOverManyBounces) {
+    // rho = 0.9: the throughput falls below the default threshold (0.05) after ~29 bounces, so
+    // the roulette thins the tail of 64 bounces; every layer must still match rho^k.
+    const ReferenceSettings defaults;
+    checkFurnace(0.9f, Estimator::Mis, 64, 1024, defaults.rouletteStartBounce);
+}
+
+TEST(CpuReferenceFurnace, SobolSamplerIsUnbiased) {
+    checkFurnace(0.8f, Estimator::Mis, 12, 1024, 4, SamplerKind::Sobol);
+    checkFurnace(0.5f, Estimator::NeeOnly, 6, 512, -1, SamplerKind::Sobol);
 }
 
 TEST(CpuReferenceFurnace, LayersBeyondMaxBouncesAreZero) {
@@ -548,11 +561,13 @@ bool sameSums(const Accumulator& a, const Accumulator& b) {
            std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0;
 }
 
-TEST(CpuReferenceDeterminism, ThreadsBatchesAndSeeds) {
+void checkThreadsBatchesAndSeeds(SamplerKind sampler) {
     Scene scene = smallCornell(24);
     scene.lights.push_back(pointLight({0.3f, 0.4f, 0.3f}, glm::vec3(0.05f)));
     scene.computeCaps();
-    const ReferenceSettings st = settingsWith(Estimator::Mis, 4, 11);
+    ReferenceSettings st = settingsWith(Estimator::Mis, 4, 11);
+    st.sampler = sampler;
+    st.rouletteStartBounce = 1;  // the roulette's draws are part of the stream too
     auto renderWith = [&](int threads, std::vector<uint32_t> batches, uint64_t seed) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
         ReferenceSettings s = st;
@@ -573,6 +588,104 @@ TEST(CpuReferenceDeterminism, ThreadsBatchesAndSeeds) {
     EXPECT_TRUE(sameSums(two, split)) << "8 vs 4 + 4 samples";
     EXPECT_TRUE(sameSums(two, uneven)) << "8 vs 1 + 2 + 5 samples";
     EXPECT_FALSE(sameSums(two, other)) << "another seed";
+}
+
+TEST(CpuReferenceDeterminism, ThreadsBatchesAndSeeds) {
+    checkThreadsBatchesAndSeeds(SamplerKind::Independent);
+}
+
+TEST(CpuReferenceDeterminism, SobolThreadsBatchesAndSeeds) {
+    checkThreadsBatchesAndSeeds(SamplerKind::Sobol);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Samplers (docs/reference.md, "Samplers")
+// ---------------------------------------------------------------------------------------------
+
+/** Cells of a 1D (256) and a 2D (16 x 16) grid holding other than exactly one of 256 samples. */
+struct Strata {
+    int badPixelPad = 0, badSelect = 0, badLight = 0, badLobe = 0;
+};
+
+Strata strataOf(SamplerKind kind, uint64_t pixel) {
+    int pixelPad[16][16] = {}, light[16][16] = {}, select[256] = {}, lobe[256] = {};
+    for (uint32_t s = 0; s < 256; ++s) {
+        Sampler sm(7, pixel, s, kind);
+        const glm::vec2 u = sm.get2D();     // the camera ray's pixel position
+        const double d = sm.get1DDouble();  // light selection
+        const glm::vec2 p = sm.get2D();     // point on the light
+        const float l = sm.get1D();         // BSDF lobe
+        ++pixelPad[int(u.x * 16)][int(u.y * 16)];
+        ++select[int(d * 256)];
+        ++light[int(p.x * 16)][int(p.y * 16)];
+        ++lobe[int(l * 256)];
+    }
+    Strata st;
+    for (int i = 0; i < 256; ++i) {
+        st.badPixelPad += pixelPad[i / 16][i % 16] != 1;
+        st.badLight += light[i / 16][i % 16] != 1;
+        st.badSelect += select[i] != 1;
+        st.badLobe += lobe[i] != 1;
+    }
+    return st;
+}
+
+TEST(CpuReferenceSampler, SobolDrawsAreStratifiedPerPixelAndLaterDrawsVary) {
+    for (uint64_t pixel : {0ull, 12345ull, 1ull << 40}) {
+        const Strata sobol = strataOf(SamplerKind::Sobol, pixel);
+        EXPECT_EQ(sobol.badPixelPad, 0) << pixel;
+        EXPECT_EQ(sobol.badSelect, 0) << pixel;
+        EXPECT_EQ(sobol.badLight, 0) << pixel;
+        EXPECT_EQ(sobol.badLobe, 0) << pixel;
+        // i.i.d. uniforms leave about 256 / e empty cells: the check can tell them apart
+        const Strata iid = strataOf(SamplerKind::Independent, pixel);
+        EXPECT_GT(iid.badLight, 100) << pixel;
+    }
+    // Past the stratified draws the numbers are i.i.d. per sample, not shared by the pixel
+    double sum = 0.0;
+    int distinct = 0;
+    float previous = -1.0f;
+    for (uint32_t s = 0; s < 1024; ++s) {
+        Sampler sm(7, 3, s, SamplerKind::Sobol);
+        for (int i = 0; i < 8; ++i)
+            sm.get1D();
+        const float v = sm.get1D();
+        sum += v;
+        distinct += v != previous;
+        previous = v;
+    }
+    EXPECT_EQ(distinct, 1024);
+    EXPECT_NEAR(sum / 1024.0, 0.5, 4.0 * std::sqrt(1.0 / 12.0 / 1024.0));
+}
+
+TEST(CpuReferenceSampler, SobolHasLowerErrorThanIndependentUnderAnAreaLight) {
+    // A plane under a square emitter, direct light through pixel centres: the error of 64 spp
+    // against 8192 i.i.d. spp, summed over pixels, must drop with the stratified sampler.
+    const Camera cam = lookDown({0.0f, 0.5f, 0.0f}, 40.0f);
+    Scene s = planeScene(12, cam);
+    addHorizontalQuad(s, 1.0f, 0.25f, -1.0f,
+                      addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(3.0f, 2.0f, 1.0f))));
+    ReferenceSettings st = settingsWith(Estimator::Mis, 0);
+    st.pixelFilter = PixelFilter::Center;
+    const Accumulator truth = render(s, st, 8192);
+    auto sqError = [&](SamplerKind kind) {
+        ReferenceSettings k = st;
+        k.sampler = kind;
+        k.seed = 3;
+        const Accumulator acc = render(s, k, 64);
+        double e = 0.0;
+        for (int y = 0; y < acc.height; ++y)
+            for (int x = 0; x < acc.width; ++x) {
+                const double d =
+                    acc.mean(Layer::Direct, x, y, 0) - truth.mean(Layer::Direct, x, y, 0);
+                e += d * d;
+            }
+        return e;
+    };
+    const double iid = sqError(SamplerKind::Independent), sobol = sqError(SamplerKind::Sobol);
+    std::printf("[ measured ] direct light, 64 spp: squared error sobol / independent = %.3f\n",
+                sobol / iid);
+    EXPECT_LT(sobol, 0.5 * iid);
 }
 
 TEST(CpuReferenceDeterminism, TexturedSceneWithOneOrTwoThreads) {
@@ -619,9 +732,9 @@ TEST(CpuReferenceDeterminism, CancelledBatchLeavesAccumulatorUnchanged) {
 TEST(CpuReferenceDeterminism, PacketAndScalarCameraRaysAgree) {
     // Both camera-ray paths are valid estimators of the same image (hits may differ in ulps)
     Scene scene = smallCornell(16);
-    setCameraPackets(false);
+    setRayPackets(false);
     const Accumulator scalar = render(scene, settingsWith(Estimator::Mis, 1), 16);
-    setCameraPackets(true);
+    setRayPackets(true);
     const Accumulator packets = render(scene, settingsWith(Estimator::Mis, 1), 16);
     const Estimate a = imageMean(scalar, Layer::Full, 0), b = imageMean(packets, Layer::Full, 0);
     EXPECT_LE(std::abs(a.mean - b.mean), 1e-4 * a.mean + 4.0 * std::hypot(a.sigma, b.sigma));
@@ -950,7 +1063,7 @@ namespace {
 void measureThroughput(const Scene& scene, const ReferenceSettings& st, uint32_t spp) {
     PathTracer tracer(scene, st);
     for (bool packets : {true, false}) {
-        setCameraPackets(packets);
+        setRayPackets(packets);
         Accumulator acc;
         acc.reset(scene.settings.width, scene.settings.height);
         tracer.addSamples(acc, 1);  // warm-up
@@ -969,7 +1082,7 @@ void measureThroughput(const Scene& scene, const ReferenceSettings& st, uint32_t
             rays / seconds * 1e-6, rays / cpuSeconds * 1e-6,
             100.0 * double(after.shadowRays - before.shadowRays) / rays);
     }
-    setCameraPackets(true);
+    setRayPackets(true);
 }
 
 // Center: every camera ray goes through the pixel centre, so the emitter seen directly covers a

@@ -66,15 +66,17 @@ void printReplayTable(const std::vector<ref::BenchSceneResult>& results) {
 void printRatioTable(const std::vector<ref::BenchSceneResult>& results) {
     std::printf("\npath tracer rate / raw Embree rate for the same ray mix (%d threads)\n",
                 results.front().threads);
-    std::printf("%-22s %12s %11s %11s %11s %11s\n", "scene", "PT Mr/s", "vs 1", "vs 8", "vs 16",
-                "vs 1M");
+    std::printf("%-22s %12s %11s %11s %11s %11s %11s\n", "scene", "PT Mr/s", "vs 1", "vs 8",
+                "vs 16", "vs 1M", "vs best");
     for (const ref::BenchSceneResult& r : results) {
         std::printf("%-22s %12.2f", r.scene.c_str(), mega(r.raysPerSecond()));
+        double best = 0.0;
         for (const char* method : {"1", "8", "16", "1M"}) {
             const double raw = r.rawMixRaysPerSecond(method, r.threads);
+            best = std::max(best, raw);
             std::printf(" %11.3f", raw > 0.0 ? r.raysPerSecond() / raw : 0.0);
         }
-        std::printf("\n");
+        std::printf(" %11.3f\n", best > 0.0 ? r.raysPerSecond() / best : 0.0);
     }
 }
 
@@ -83,8 +85,8 @@ void printConvergenceTable(const std::vector<ref::BenchSceneResult>& results) {
         "\ntime to a relative MSE of %g against a long run (other seed); extrapolated: "
         "against the exact image, from the last point\n",
         results.front().convergence.targetRelMse);
-    std::printf("%-22s %9s %9s %8s %8s %9s %9s %9s\n", "scene", "predicted", "long spp", "long s",
-                "spp", "seconds", "extr spp", "extr s");
+    std::printf("%-22s %9s %9s %8s %8s %9s %9s %9s %9s %11s\n", "scene", "predicted", "long spp",
+                "long s", "spp", "seconds", "extr spp", "extr s", "s/spp", "efficiency");
     for (const ref::BenchSceneResult& r : results) {
         const ref::BenchConvergence& c = r.convergence;
         char spp[32] = "not", seconds[32] = "reached";
@@ -92,10 +94,10 @@ void printConvergenceTable(const std::vector<ref::BenchSceneResult>& results) {
             std::snprintf(spp, sizeof spp, "%llu", (unsigned long long)c.samples);
             std::snprintf(seconds, sizeof seconds, "%.2f", c.seconds);
         }
-        std::printf("%-22s %9llu %9llu %8.1f %8s %9s %9llu %9.1f\n", r.scene.c_str(),
+        std::printf("%-22s %9llu %9llu %8.1f %8s %9s %9llu %9.1f %9.4f %11.4g\n", r.scene.c_str(),
                     (unsigned long long)c.predictedSamples, (unsigned long long)c.longSamples,
                     c.longSeconds, spp, seconds, (unsigned long long)c.extrapolatedSamples,
-                    c.extrapolatedSeconds);
+                    c.extrapolatedSeconds, c.secondsPerSample(), c.efficiency());
     }
 }
 
@@ -108,6 +110,12 @@ int runBenchReference(const BenchReferenceOptions& options) {
 
     ref::ReferenceSettings settings;
     settings.maxBounces = options.maxBounces;
+    settings.rouletteStartBounce = options.rouletteDepth;
+    settings.rouletteThreshold = options.rouletteThreshold;
+    settings.pixelFilter =
+        options.pixelFilter == "center" ? ref::PixelFilter::Center : ref::PixelFilter::Box;
+    settings.sampler =
+        options.sampler == "sobol" ? ref::SamplerKind::Sobol : ref::SamplerKind::Independent;
     ref::BenchOptions bench;
     bench.spp = options.spp;
     bench.longSpp = options.longSpp;

@@ -201,8 +201,12 @@ int runMain(int argc, char** argv) {
         ->check(CLI::Range(0, 1024))
         ->capture_default_str();
     ref->add_option("--roulette-depth", reference.rouletteDepth,
-                    "Russian roulette after this bounce; -1 = off")
+                    "Russian roulette on paths past this bounce; -1 = off")
         ->check(CLI::Range(-1, 1024))
+        ->capture_default_str();
+    ref->add_option("--roulette-threshold", reference.rouletteThreshold,
+                    "Roulette survival probability min(1, max(throughput) / this)")
+        ->check(CLI::Range(1e-6f, 1.0f))
         ->capture_default_str();
     ref->add_option("--estimator", reference.estimator, "Light estimator")
         ->check(CLI::IsMember({"mis", "nee", "bsdf"}))
@@ -212,6 +216,11 @@ int runMain(int argc, char** argv) {
                     "box: rays over the whole pixel; center: through the pixel centre, like the "
                     "rasteriser")
         ->check(CLI::IsMember({"box", "center"}))
+        ->capture_default_str();
+    ref->add_option("--sampler", reference.sampler,
+                    "independent: i.i.d. uniforms (exact per-pixel error bars); sobol: "
+                    "Owen-scrambled Sobol (faster convergence, conservative error bars)")
+        ->check(CLI::IsMember({"independent", "sobol"}))
         ->capture_default_str();
     ref->add_option("--batch", reference.batchSamples,
                     "Samples per pass (stop criteria are checked between passes; no effect on "
@@ -262,6 +271,25 @@ int runMain(int argc, char** argv) {
         ->capture_default_str();
     benchRefCmd->add_option("--max-bounces", benchRef.maxBounces, "Indirect bounces")
         ->check(CLI::Range(0, 1024))
+        ->capture_default_str();
+    benchRefCmd
+        ->add_option("--roulette-depth", benchRef.rouletteDepth,
+                     "Russian roulette on paths past this bounce; -1 = off")
+        ->check(CLI::Range(-1, 1024))
+        ->capture_default_str();
+    benchRefCmd
+        ->add_option("--roulette-threshold", benchRef.rouletteThreshold,
+                     "Roulette survival probability min(1, max(throughput) / this)")
+        ->check(CLI::Range(1e-6f, 1.0f))
+        ->capture_default_str();
+    benchRefCmd
+        ->add_option("--pixel-filter", benchRef.pixelFilter,
+                     "box: rays over the whole pixel; center: through the pixel centre")
+        ->check(CLI::IsMember({"box", "center"}))
+        ->capture_default_str();
+    benchRefCmd
+        ->add_option("--sampler", benchRef.sampler, "independent or sobol (docs/reference.md)")
+        ->check(CLI::IsMember({"independent", "sobol"}))
         ->capture_default_str();
     benchRefCmd->add_option("--out,-o", benchRef.outDir, "Also write bench_reference.json here");
     benchRefCmd->add_flag("--quiet,-q", benchRef.quiet, "No progress lines");

@@ -13,6 +13,7 @@
 #include "core/params/params.h"
 #include "core/scene/scene.h"
 #include "core/util/error.h"
+#include "reference/path_tracer.h"
 
 namespace gilab::cli {
 
@@ -88,9 +89,11 @@ struct ReferenceOptions {
     double relError = 0.0;
     double seconds = 0.0;
     int maxBounces = 32;
-    int rouletteDepth = -1;
-    std::string estimator = "mis";    // mis | nee | bsdf
-    std::string pixelFilter = "box";  // "box" | "center"
+    int rouletteDepth = ref::ReferenceSettings{}.rouletteStartBounce;
+    float rouletteThreshold = ref::ReferenceSettings{}.rouletteThreshold;
+    std::string estimator = "mis";        // mis | nee | bsdf
+    std::string pixelFilter = "box";      // "box" | "center"
+    std::string sampler = "independent";  // "independent" | "sobol"
     uint64_t seed = 1;
     uint32_t batchSamples = 4;
     std::string frames;      // animated scenes: "all", "every:K", "0,4,8"; "" = static
@@ -115,7 +118,11 @@ struct BenchReferenceOptions {
     double longMaxSeconds = 120.0;    // cap of the long run (and of the run measured against it)
     double targetRelMse = 1e-3;
     int maxBounces = 32;
-    std::string outDir;  // "" = print only
+    int rouletteDepth = ref::ReferenceSettings{}.rouletteStartBounce;
+    float rouletteThreshold = ref::ReferenceSettings{}.rouletteThreshold;
+    std::string pixelFilter = "box";      // "box" | "center"
+    std::string sampler = "independent";  // "independent" | "sobol"
+    std::string outDir;                   // "" = print only
     bool quiet = false;
     std::string commandLine;
 };

@@ -87,9 +87,12 @@ int renderReference(const ReferenceOptions& options, const Scene& scene,
     ref::ReferenceSettings settings;
     settings.maxBounces = options.maxBounces;
     settings.rouletteStartBounce = options.rouletteDepth;
+    settings.rouletteThreshold = options.rouletteThreshold;
     settings.estimator = parseEstimator(options.estimator);
     settings.pixelFilter =
         options.pixelFilter == "center" ? ref::PixelFilter::Center : ref::PixelFilter::Box;
+    settings.sampler =
+        options.sampler == "sobol" ? ref::SamplerKind::Sobol : ref::SamplerKind::Independent;
     settings.seed = options.seed;
     settings.batchSamples = options.batchSamples;
     ref::StopCriteria stop{options.spp, options.relError, options.seconds};

@@ -59,8 +59,9 @@ SceneEntry parseScene(const JsonNode& node, const std::string& baseDir, int defa
 
 ReferenceRequest parseReference(const JsonNode& node) {
     ReferenceRequest r;
-    node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce", "seed",
-                     "estimator", "batch_spp", "pixel_filter", "frames"});
+    node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce",
+                     "roulette_threshold", "seed", "estimator", "batch_spp", "pixel_filter",
+                     "sampler", "frames"});
     if (node.has("frames")) {
         const JsonNode f = node["frames"];
         if (f.raw().is_string()) {
@@ -77,6 +78,8 @@ ReferenceRequest parseReference(const JsonNode& node) {
     if (node.has("max_bounces")) r.settings.maxBounces = node["max_bounces"].integerIn(0, 1024);
     if (node.has("roulette_start_bounce"))
         r.settings.rouletteStartBounce = node["roulette_start_bounce"].integerIn(-1, 1024);
+    if (node.has("roulette_threshold"))
+        r.settings.rouletteThreshold = float(node["roulette_threshold"].numberIn(1e-6, 1.0));
     if (node.has("seed")) r.settings.seed = uint64_t(node["seed"].integerIn(0, 1 << 30));
     if (node.has("batch_spp"))
         r.settings.batchSamples = uint32_t(node["batch_spp"].integerIn(1, 4096));
@@ -88,6 +91,15 @@ ReferenceRequest parseReference(const JsonNode& node) {
             r.settings.pixelFilter = ref::PixelFilter::Center;
         else
             node["pixel_filter"].fail("expected box or center (got \"" + f + "\")");
+    }
+    if (node.has("sampler")) {
+        const std::string k = node["sampler"].string();
+        if (k == "independent")
+            r.settings.sampler = ref::SamplerKind::Independent;
+        else if (k == "sobol")
+            r.settings.sampler = ref::SamplerKind::Sobol;
+        else
+            node["sampler"].fail("expected independent or sobol (got \"" + k + "\")");
     }
     if (node.has("estimator")) {
         const std::string e = node["estimator"].string();
