@@ -268,8 +268,8 @@ void Integrator::prefetchTexels(const PathState& p) const {
     if (texture >= 0) m_textures.prefetch(texture, triangleUv(m_scene, tri, {p.hit.u, p.hit.v}));
 }
 
-void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool packets,
-                            PathCounters& counters, std::vector<RecordedRay>* sink,
+void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool cameraHitsKnown,
+                            bool packets, PathCounters& counters, std::vector<RecordedRay>* sink,
                             WaveScratch& scratch) const {
     for (const PathState& p : paths)
         for (glm::vec3& l : out[p.slot].L)
@@ -283,11 +283,13 @@ void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bo
 
     for (bool cameraRays = true; !active.empty(); cameraRays = false) {
         // 1. The closest hits of every live path's ray (camera rays are coherent)
-        traceClosest(paths, active, packets, cameraRays);
-        (cameraRays ? counters.cameraRays : counters.bounceRays) += active.size();
-        if (sink)
-            for (uint32_t i : active)
-                sink->push_back({paths[i].rayO, paths[i].rayD, 0.0f, kInfinity, false});
+        if (!(cameraRays && cameraHitsKnown)) {
+            traceClosest(paths, active, packets, cameraRays);
+            (cameraRays ? counters.cameraRays : counters.bounceRays) += active.size();
+            if (sink)
+                for (uint32_t i : active)
+                    sink->push_back({paths[i].rayO, paths[i].rayD, 0.0f, kInfinity, false});
+        }
 
         // 2. Shade every hit; the paths that go on form the next wave, in order
         // Hits are random accesses into the mesh and textures: prefetch, a wave at a time, the

@@ -79,12 +79,13 @@ public:
 
     /**
      * Traces every path from its camera ray (rayO, rayD set, vertex = 1) to its end; out[slot]
-     * receives the path's radiance per layer. `packets`: rtcIntersect16/rtcOccluded16 (default)
-     * or one rtcIntersect1/rtcOccluded1 per ray (benchmarks; the same estimator). `sink`
-     * receives every ray traced (benchmarks), or nullptr.
+     * receives the path's radiance per layer. `cameraHitsKnown`: the paths' hit/found already
+     * hold the camera ray's closest hit (pixel-centre rays, traced once per pixel). `packets`:
+     * rtcIntersect16 + an rtcOccluded1M stream (default) or one rtcIntersect1/rtcOccluded1
+     * per ray (benchmarks; the same estimator). `sink` receives every ray traced, or nullptr.
      */
-    void tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool packets,
-                    PathCounters& counters, std::vector<RecordedRay>* sink,
+    void tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool cameraHitsKnown,
+                    bool packets, PathCounters& counters, std::vector<RecordedRay>* sink,
                     WaveScratch& scratch) const;
 
 private:

@@ -172,10 +172,45 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
 
     // Waves of kWaveSamples samples of every tile pixel; within a sample, 4 x 4 pixel blocks
     // (one camera-ray packet each). Each pixel still receives its samples in index order.
-    const Camera& camera = scene.camera;
+    const PrimaryRays cameraRay(scene.camera, w, h);
     TileScratch& ws = scratch.local();
     std::vector<PathState>& paths = ws.paths;
     std::vector<int>& pathPixel = ws.pathPixel;
+
+    // Pixel-centre rays are the same for every sample: trace each once per call, same packets
+    const bool center = settings.pixelFilter == PixelFilter::Center;
+    RayHit cameraHit[kTileSize * kTileSize];
+    if (center) {
+        for (int by = y0; by < y1; by += kPacketSize)
+            for (int bx = x0; bx < x1; bx += kPacketSize) {
+                glm::vec3 o[16], d[16];
+                int tilePixel[16];
+                int n = 0;
+                for (int y = by; y < std::min(by + kPacketSize, y1); ++y)
+                    for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x, ++n) {
+                        const Ray ray = cameraRay(float(x) + 0.5f, float(y) + 0.5f);
+                        o[n] = ray.origin;
+                        d[n] = ray.direction;
+                        tilePixel[n] = (y - y0) * tw + (x - x0);
+                    }
+                RayHit hits[16];
+                if (packets) {
+                    mesh.intersect16(n, o, d, std::numeric_limits<float>::infinity(), hits);
+                } else {
+                    for (int i = 0; i < n; ++i)
+                        if (!mesh.intersect(o[i], d[i], 0.0f,
+                                            std::numeric_limits<float>::infinity(), hits[i]))
+                            hits[i].prim = ~0u;
+                }
+                for (int i = 0; i < n; ++i) {
+                    cameraHit[tilePixel[i]] = hits[i];
+                    if (sink)
+                        sink->push_back(
+                            {o[i], d[i], 0.0f, std::numeric_limits<float>::infinity(), false});
+                }
+                counters.cameraRays += uint64_t(n);
+            }
+    }
     for (uint64_t s0 = first; s0 < first + count; s0 += kWaveSamples) {
         const uint64_t s1 = std::min<uint64_t>(first + count, s0 + kWaveSamples);
         paths.clear();
@@ -189,14 +224,19 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
                             PathState& path = paths.emplace_back();
                             path.sampler = Sampler(settings.seed, pixelIndex, s, settings.sampler);
                             const glm::vec2 u = pixelOffset(path.sampler, settings.pixelFilter);
-                            const Ray ray = camera.primaryRay(float(x) + u.x, float(y) + u.y, w, h);
+                            const Ray ray = cameraRay(float(x) + u.x, float(y) + u.y);
                             path.rayO = ray.origin;
                             path.rayD = ray.direction;
                             path.slot = uint32_t(paths.size() - 1);
-                            pathPixel.push_back((y - y0) * tw + (x - x0));
+                            const int tilePixel = (y - y0) * tw + (x - x0);
+                            pathPixel.push_back(tilePixel);
+                            if (center) {
+                                path.hit = cameraHit[tilePixel];
+                                path.found = path.hit.prim != ~0u;
+                            }
                         }
         ws.radiance.resize(paths.size());
-        integrator.tracePaths(paths, ws.radiance.data(), packets, counters, sink, ws.wave);
+        integrator.tracePaths(paths, ws.radiance.data(), center, packets, counters, sink, ws.wave);
         for (size_t i = 0; i < paths.size(); ++i)
             add(pathPixel[i], ws.radiance[i]);
     }

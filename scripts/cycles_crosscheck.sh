@@ -15,6 +15,8 @@
 #
 # usage: scripts/cycles_crosscheck.sh [--resolution N] [--gilab-spp LIST] [--cycles-spp LIST]
 #          [--long-spp L] [--threads T] [--out DIR] [--scene-gltf PATH] [--cycles-roulette on|off]
+#          [--gilab-sampler independent|sobol]
+#   --gilab-sampler: the sampler of gilab's measured runs (the converged run is independent)
 #   --cycles-roulette off: no Russian roulette in Cycles (default on, as Cycles ships; gilab's
 #     reference thins only paths past bounce 4 whose throughput fell below 0.05)
 #   env GILAB: the gilab binary (default build/gilab)
@@ -24,13 +26,14 @@ set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 res=256 gilab_spp=64,256 cycles_spp=64,256,1024 long_spp=4096 threads=2 roulette=on
+sampler=independent
 out=results/cycles_crosscheck
 gltf=$root/../shared/scenes/cornell-box/cornell_box.gltf
 gilab=${GILAB:-$root/build/gilab}
 py=/usr/bin/python3
 
 die() { echo "cycles_crosscheck: $*" >&2; exit 1; }
-usage() { sed -n '16,22p' "$0"; exit "${1:-2}"; }
+usage() { sed -n '16,24p' "$0"; exit "${1:-2}"; }
 
 while [[ $# -gt 0 ]]; do
     [[ $1 == -h || $1 == --help ]] && usage 0
@@ -44,11 +47,14 @@ while [[ $# -gt 0 ]]; do
         --out) out=$2 ;;
         --scene-gltf) gltf=$2 ;;
         --cycles-roulette) roulette=$2 ;;
+        --gilab-sampler) sampler=$2 ;;
         *) echo "unknown option $1" >&2; usage ;;
     esac
     shift 2
 done
 [[ $roulette == on || $roulette == off ]] || die "--cycles-roulette takes on or off"
+[[ $sampler == independent || $sampler == sobol ]] ||
+    die "--gilab-sampler takes independent or sobol"
 min_light_bounces=0
 [[ $roulette == on ]] || min_light_bounces=64
 for v in "$res" "$long_spp" "$threads" ${gilab_spp//,/ } ${cycles_spp//,/ }; do
@@ -92,11 +98,11 @@ PY
 pin=()
 if [[ $threads -lt $(nproc) ]]; then pin=(taskset -c "0-$((threads - 1))"); fi
 
-gilab_render() {  # spp seed dir
-    echo "gilab:  $1 spp (seed $2) -> $3"
+gilab_render() {  # spp seed dir sampler
+    echo "gilab:  $1 spp (seed $2, $4 sampler) -> $3"
     "${pin[@]}" "$gilab" reference --scene "$out/scene.json" --resolution "${res}x${res}" \
-        --max-bounces 64 --pixel-filter center --spp "$1" --seed "$2" --no-cache -o "$3" -q \
-        >/dev/null || die "gilab reference failed ($3)"
+        --max-bounces 64 --pixel-filter center --spp "$1" --seed "$2" --sampler "$4" \
+        --no-cache -o "$3" -q >/dev/null || die "gilab reference failed ($3)"
 }
 
 cycles_render() {  # spp seed exr
@@ -109,9 +115,13 @@ cycles_render() {  # spp seed exr
         { tail -n 20 "${3%.exr}.log" >&2; die "cycles_render.py did not finish (${3%.exr}.log)"; }
 }
 
-gilab_render "$long_spp" 1 "$out/gilab_long"
+# The converged image uses i.i.d. samples: its stderr layer (its own noise) must be exact
+gilab_render "$long_spp" 1 "$out/gilab_long" independent
 seed=2
-for n in ${gilab_spp//,/ }; do gilab_render "$n" $seed "$out/gilab_spp$n"; seed=$((seed + 1)); done
+for n in ${gilab_spp//,/ }; do
+    gilab_render "$n" $seed "$out/gilab_spp$n" "$sampler"
+    seed=$((seed + 1))
+done
 seed=1
 for n in ${cycles_spp//,/ }; do
     cycles_render "$n" $seed "$out/cycles_spp$n.exr"; seed=$((seed + 1))
@@ -243,8 +253,14 @@ lines.append("Orientation (relMSE of Cycles vs gilab, Cycles flipped): " +
              ", ".join(f"{k} {v:.4g}" for k, v in flips.items()) +
              ("" if orientation_ok else "  ** a flipped image matches better: camera mismatch **"))
 threads = long_info.get("threads")
+st = long_info.get("settings", {})
+measured = json.load(open(f"{out}/gilab_spp{gilab_spp[-1]}/reference.json")).get("settings", {})
+rr = st.get("roulette_start_bounce", -1)
+gilab_rr = (f"Russian roulette past bounce {rr} below throughput {st.get('roulette_threshold', 1):.3g}"
+            if rr >= 0 else "no Russian roulette")
 head = [f"# Cycles cross-check ({y.shape[1]}x{y.shape[0]})", "",
-        f"gilab reference path tracer ({threads} threads, no Russian roulette) vs Blender "
+        f"gilab reference path tracer v{long_info.get('renderer', {}).get('version', '?')} "
+        f"({threads} threads, {measured.get('sampler', 'independent')} sampler, {gilab_rr}) vs Blender "
         f"{blender_version} Cycles (CPU, Russian roulette {'on' if cycles_rr else 'off'}); "
         "times are the render calls only (Cycles: bpy render incl. scene sync and EXR write; "
         "gilab: reference.json seconds).", ""]

@@ -27,12 +27,17 @@ glm::mat4 Camera::projection(float aspect) const {
 }
 
 Ray Camera::primaryRay(float px, float py, int width, int height) const {
-    const float aspect = float(width) / float(height);
-    const float tanHalf = std::tan(0.5f * vfovRad);
-    const float ndcX = 2.0f * px / float(width) - 1.0f;
-    const float ndcY = 1.0f - 2.0f * py / float(height);
-    const glm::vec3 d = forward() + ndcX * tanHalf * aspect * right() + ndcY * tanHalf * trueUp();
-    return {position, glm::normalize(d)};
+    return PrimaryRays(*this, width, height)(px, py);
 }
+
+PrimaryRays::PrimaryRays(const Camera& camera, int width, int height)
+    : m_position(camera.position),
+      m_forward(camera.forward()),
+      m_right(camera.right()),
+      m_up(camera.trueUp()),
+      m_width(float(width)),
+      m_height(float(height)),
+      m_aspect(float(width) / float(height)),
+      m_tanHalf(std::tan(0.5f * camera.vfovRad)) {}
 
 }  // namespace gilab

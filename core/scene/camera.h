@@ -32,4 +32,22 @@ struct Camera {
     Ray primaryRay(float px, float py, int width, int height) const;
 };
 
+/** Camera::primaryRay with the camera basis computed once (path tracers call it per sample);
+ *  the same arithmetic, so the same rays bit for bit. */
+class PrimaryRays {
+public:
+    PrimaryRays(const Camera& camera, int width, int height);
+    Ray operator()(float px, float py) const {
+        const float ndcX = 2.0f * px / m_width - 1.0f;
+        const float ndcY = 1.0f - 2.0f * py / m_height;
+        const glm::vec3 d =
+            m_forward + ndcX * m_tanHalf * m_aspect * m_right + ndcY * m_tanHalf * m_up;
+        return {m_position, glm::normalize(d)};
+    }
+
+private:
+    glm::vec3 m_position, m_forward, m_right, m_up;
+    float m_width, m_height, m_aspect, m_tanHalf;
+};
+
 }  // namespace gilab
