@@ -515,6 +515,17 @@ TEST(CpuReferenceBench, ReplayAndConvergenceRunOnATinyScene) {
     EXPECT_TRUE(r.convergence.reached);
     EXPECT_LT(r.convergence.curve.back().relMseVsLong, 0.5);
     EXPECT_TRUE(ref::benchSceneJson(r)["raw_embree"]["closest"].is_array());
+    // Efficiency 1 / (relMSE x seconds) from the extrapolation; the best raw mode is at least
+    // as fast as single rays, so the path tracer's ratio to it is at most its ratio to those
+    const nlohmann::ordered_json j = ref::benchSceneJson(r);
+    const ref::BenchConvergence& c = r.convergence;
+    ASSERT_GT(c.extrapolatedSeconds, 0.0);
+    EXPECT_DOUBLE_EQ(c.efficiency(), 1.0 / (o.targetRelMse * c.extrapolatedSeconds));
+    EXPECT_DOUBLE_EQ(c.secondsPerSample(), c.curve.back().seconds / double(c.curve.back().samples));
+    EXPECT_DOUBLE_EQ(j["convergence"]["efficiency"].get<double>(), c.efficiency());
+    const double overBest = j["raw_embree"]["path_tracer_over_best_raw_mt"].get<double>();
+    EXPECT_GT(overBest, 0.0);
+    EXPECT_LE(overBest, j["raw_embree"]["path_tracer_over_raw_1_mt"].get<double>());
 }
 
 }  // namespace gilab
