@@ -230,36 +230,6 @@ void EmbreeScene::intersect16(int count, const glm::vec3* o, const glm::vec3* d,
     }
 }
 
-void EmbreeScene::occluded16(int count, const glm::vec3* o, const glm::vec3* d, const float* tFar,
-                             bool* occluded) const {
-    alignas(64) int valid[16];
-    alignas(64) RTCRay16 ray;
-    for (int i = 0; i < 16; ++i) {
-        const bool active = i < count;
-        valid[i] = active ? -1 : 0;
-        const glm::vec3 oi = active ? o[i] : glm::vec3(0.0f);
-        const glm::vec3 di = active ? d[i] : glm::vec3(0.0f, 0.0f, 1.0f);
-        ray.org_x[i] = oi.x;
-        ray.org_y[i] = oi.y;
-        ray.org_z[i] = oi.z;
-        ray.tnear[i] = 0.0f;
-        ray.dir_x[i] = di.x;
-        ray.dir_y[i] = di.y;
-        ray.dir_z[i] = di.z;
-        ray.time[i] = 0.0f;
-        ray.tfar[i] = active ? tFar[i] : 0.0f;
-        ray.mask[i] = ~0u;
-        ray.id[i] = unsigned(i);
-        ray.flags[i] = 0;
-    }
-    RTCIntersectContext context;
-    rtcInitIntersectContext(&context);
-    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
-    rtcOccluded16(valid, m_scene, &context, &ray);
-    for (int i = 0; i < count; ++i)
-        occluded[i] = ray.tfar[i] < 0.0f;  // Embree sets tfar = -inf on a hit
-}
-
 void EmbreeScene::occludedStream(std::vector<RTCRay>& rays) const {
     if (rays.empty()) return;
     RTCIntersectContext context;

@@ -69,9 +69,6 @@ public:
     /** Occlusion of every ray in one rtcOccluded1M stream call (Embree regroups the rays);
      *  an occluded ray gets tfar = -inf. */
     void occludedStream(std::vector<RTCRay>& rays) const;
-    /** Occlusion of up to 16 rays o + t d, t in [0, tFar[i]], in one rtcOccluded16 call. */
-    void occluded16(int count, const glm::vec3* o, const glm::vec3* d, const float* tFar,
-                    bool* occluded) const;
 
     /** Throws gilab::Error with Embree's message if the device reports an error. */
     void checkError(const char* what) const;

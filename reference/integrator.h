@@ -13,8 +13,9 @@
  *
  * Paths are traced as a wavefront (docs/reference.md, "Wavefront"): all live paths' rays of one
  * depth go to Embree in 16-wide packets, then every hit is shaded (queuing its shadow rays),
- * then all shadow rays are traced in packets and the unoccluded ones add their light. Each
- * path's arithmetic and random numbers are those of tracing it alone, in the same order.
+ * then all shadow rays are traced in one rtcOccluded1M stream and the unoccluded ones add their
+ * light. Each path's arithmetic and random numbers are those of tracing it alone, in the same
+ * order.
  */
 #include <cstdint>
 #include <vector>
@@ -110,7 +111,7 @@ private:
     float m_offsetScale = 1.0f;  // offsetRayOrigin originScale of this scene
 };
 
-/** All rays in 16-wide packets (default) or one Embree call per ray; for benchmarks
+/** Closest-hit packets and a shadow-ray stream (default) or one Embree call per ray; for benchmarks
  *  (docs/reference.md, "Throughput"). Not thread-safe with rendering. */
 void setRayPackets(bool enabled);
 
