@@ -19,9 +19,7 @@ struct AlphaFilter {
             const float b1 = RTCHitN_u(args->hit, args->N, i);
             const float b2 = RTCHitN_v(args->hit, args->N, i);
             const MeshTriangle& tri = self->m_triangles[prim];
-            const std::vector<Vertex>& vs = self->m_sceneData.vertices;
-            const glm::vec2 uv =
-                (1.0f - b1 - b2) * vs[tri.v[0]].uv + b1 * vs[tri.v[1]].uv + b2 * vs[tri.v[2]].uv;
+            const glm::vec2 uv = tri.uvAt(b1, b2);
             if (isCutOut(self->m_sceneData.materials[tri.material], self->m_textures, uv))
                 args->valid[i] = 0;
         }
@@ -60,6 +58,8 @@ EmbreeScene::EmbreeScene(const Scene& scene, const TextureLookup& textures)
                 throw Error("scene '" + scene.name + "': triangle " + std::to_string(t) +
                             " indexes vertex " + std::to_string(tri.v[k]) + " of " +
                             std::to_string(scene.vertices.size()));
+            tri.normal[k] = scene.vertices[tri.v[k]].normal;
+            tri.uv[k] = scene.vertices[tri.v[k]].uv;
         }
         tri.p0 = scene.vertices[tri.v[0]].position;
         tri.e1 = scene.vertices[tri.v[1]].position - tri.p0;

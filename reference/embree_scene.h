@@ -23,14 +23,25 @@ namespace gilab::ref {
 
 class TextureLookup;
 
-/** One triangle: p = p0 + b1 e1 + b2 e2 with Embree's barycentrics (b1, b2) = (u, v). */
-struct MeshTriangle {
+/** One triangle: p = p0 + b1 e1 + b2 e2 with Embree's barycentrics (b1, b2) = (u, v). It also
+ *  carries its vertices' normals and uvs, so that shading a hit reads one aligned 128-byte
+ *  record (two adjacent cache lines) instead of the triangle plus three scattered vertices
+ *  (docs/reference.md, "Throughput"). */
+struct alignas(128) MeshTriangle {
     glm::vec3 p0, e1, e2;
     glm::vec3 n;  // unit geometric normal of the counter-clockwise winding (cross(e1, e2))
     float area = 0.0f;
     uint32_t material = 0;
     uint32_t v[3] = {0, 0, 0};  // vertex indices
+    glm::vec3 normal[3];        // the vertices' shading normals, as in Scene::vertices
+    glm::vec2 uv[3];            // the vertices' texture coordinates
+
+    /** Barycentric interpolation of the vertex uvs, (b1, b2) = Embree's (u, v). */
+    glm::vec2 uvAt(float b1, float b2) const {
+        return (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
+    }
 };
+static_assert(sizeof(MeshTriangle) == 128, "one triangle record is two cache lines");
 
 struct RayHit {
     float t = 0.0f;

@@ -38,21 +38,13 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const MeshTriangle& tri, const
     const glm::vec3 ngCcw = tri.area > 0.0f ? tri.n : wo;
     sp.frontFace = glm::dot(ngCcw, wo) >= 0.0f;
     sp.ng = sp.frontFace ? ngCcw : -ngCcw;
-    const Vertex& v0 = scene.vertices[tri.v[0]];
-    const Vertex& v1 = scene.vertices[tri.v[1]];
-    const Vertex& v2 = scene.vertices[tri.v[2]];
-    const glm::vec3 nInterp = b0 * v0.normal + b1 * v1.normal + b2 * v2.normal;
+    const glm::vec3 nInterp = b0 * tri.normal[0] + b1 * tri.normal[1] + b2 * tri.normal[2];
     const float len = glm::length(nInterp);
     sp.n = (len > 0.0f && std::isfinite(len)) ? nInterp / len : sp.ng;
     if (glm::dot(sp.n, sp.ng) < 0.0f) sp.n = -sp.n;
-    sp.uv = b0 * v0.uv + b1 * v1.uv + b2 * v2.uv;
+    sp.uv = tri.uvAt(b1, b2);
     sp.material = &scene.materials[tri.material];
     return sp;
-}
-
-glm::vec2 triangleUv(const Scene& scene, const MeshTriangle& tri, glm::vec2 bary) {
-    return (1.0f - bary.x - bary.y) * scene.vertices[tri.v[0]].uv +
-           bary.x * scene.vertices[tri.v[1]].uv + bary.y * scene.vertices[tri.v[2]].uv;
 }
 
 bool isBlack(const glm::vec3& v) {
@@ -141,7 +133,7 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
             const float cosTheta = glm::dot(sp.n, wi);
             const bool emitsToX = lm.doubleSided ? cosL != 0.0f : cosL > 0.0f;
             if (dist2 > 0.0f && emitsToX && cosTheta > 0.0f && glm::dot(sp.ng, wi) > 0.0f) {
-                const glm::vec2 uvL = triangleUv(m_scene, lt, es.bary);
+                const glm::vec2 uvL = lt.uvAt(es.bary.x, es.bary.y);
                 const glm::vec3 le = isCutOut(lm, m_textures, uvL)
                                          ? glm::vec3(0.0f)
                                          : lookupEmission(lm, m_textures, uvL);
@@ -251,21 +243,14 @@ void Integrator::prefetchTriangle(const PathState& p) const {
     if (!p.found) return;
     const char* t = reinterpret_cast<const char*>(&m_mesh.triangle(p.hit.prim));
     __builtin_prefetch(t);
-    __builtin_prefetch(t + sizeof(MeshTriangle) - 1);
-}
-
-void Integrator::prefetchVertices(const PathState& p) const {
-    if (!p.found) return;
-    const MeshTriangle& tri = m_mesh.triangle(p.hit.prim);
-    for (uint32_t v : tri.v)
-        __builtin_prefetch(&m_scene.vertices[v]);
+    __builtin_prefetch(t + 64);
 }
 
 void Integrator::prefetchTexels(const PathState& p) const {
     if (!p.found) return;
     const MeshTriangle& tri = m_mesh.triangle(p.hit.prim);
     const int texture = m_scene.materials[tri.material].baseColorTexture;
-    if (texture >= 0) m_textures.prefetch(texture, triangleUv(m_scene, tri, {p.hit.u, p.hit.v}));
+    if (texture >= 0) m_textures.prefetch(texture, tri.uvAt(p.hit.u, p.hit.v));
 }
 
 void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bool cameraHitsKnown,
@@ -293,12 +278,11 @@ void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bo
 
         // 2. Shade every hit; the paths that go on form the next wave, in order
         // Hits are random accesses into the mesh and textures: prefetch, a wave at a time, the
-        // triangles, then their vertices (they need the triangles' indices), then the
-        // base-colour texels (they need the vertices' uvs), so shading finds them in cache.
+        // triangle records, then the base-colour texels (they need the records' uvs), so
+        // shading finds them in cache. (Software pipelining, prefetching 16 and 8 hits ahead
+        // inside the shading loop, measured no different on Sponza.)
         for (uint32_t i : active)
             prefetchTriangle(paths[i]);
-        for (uint32_t i : active)
-            prefetchVertices(paths[i]);
         for (uint32_t i : active)
             prefetchTexels(paths[i]);
         shadows.clear();

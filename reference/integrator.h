@@ -95,7 +95,6 @@ private:
     bool shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& shadows) const;
 
     void prefetchTriangle(const PathState& p) const;
-    void prefetchVertices(const PathState& p) const;
     void prefetchTexels(const PathState& p) const;
 
     void traceClosest(std::vector<PathState>& paths, const std::vector<uint32_t>& active,
