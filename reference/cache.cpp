@@ -18,6 +18,7 @@
 #include "core/image/image_io.h"
 #include "core/util/build_info.h"
 #include "core/util/error.h"
+#include "core/util/file_lock.h"
 #include "reference/scene_hash.h"
 
 namespace gilab::ref {
@@ -79,7 +80,7 @@ bool isHexKey(const std::string& key) {
 /** A name no other process or thread uses: pid + a per-process counter. */
 std::string uniqueSuffix(const std::string& key) {
     static std::atomic<uint64_t> counter{0};
-    return key + "-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+    return key + "-" + processTag() + "-" + std::to_string(counter++);
 }
 
 /** Atomically swaps two paths (Linux renameat2); false if the file system cannot. */
@@ -193,6 +194,10 @@ fs::path ReferenceCache::defaultDir() {
         return fs::path(root) / "reference";
     if (const char* env = std::getenv("GILAB_REFERENCE_CACHE"); env && *env) return env;
     return fs::path("results/cache/reference");
+}
+
+fs::path ReferenceCache::lockPath(const std::string& key) const {
+    return m_dir / ".locks" / (key + ".lock");
 }
 
 fs::path ReferenceCache::entryDir(const std::string& key) const {
@@ -409,6 +414,21 @@ ReferenceResult obtainReference(const Scene& scene, const ReferenceSettings& set
     r.key = key.hex;
     const int width = scene.settings.width;
     const int height = scene.settings.height;
+
+    // 0. One process per key renders; the others wait here, then find its entry in step 1
+    std::optional<FileLock> lock;
+    if (cache) {
+        lock = FileLock::acquire(cache->lockPath(r.key), options.cancel, [&] {
+            std::fprintf(stderr,
+                         "[gilab] reference %s is being rendered by another process; waiting "
+                         "for it (lock %s)\n",
+                         r.key.c_str(), cache->lockPath(r.key).string().c_str());
+        });
+        if (!lock) {
+            r.reason = StopReason::Cancelled;
+            return r;
+        }
+    }
 
     // 1. A stored entry: reuse it, or continue from it
     std::optional<CachedReference> stored;

@@ -51,6 +51,8 @@ public:
 
     const std::filesystem::path& dir() const { return m_dir; }
     std::filesystem::path entryDir(const std::string& key) const;
+    /** <cache>/.locks/<key>.lock: held (FileLock) by the one process rendering `key`. */
+    std::filesystem::path lockPath(const std::string& key) const;
 
     /**
      * The entry for `key`, or nullopt when there is none. A corrupt entry (a file missing,
@@ -101,11 +103,13 @@ struct ReferenceResult {
 bool satisfiesStop(uint64_t samples, double relError, const StopCriteria& stop);
 
 /**
- * The reference for (scene, settings) meeting `stop`: a complete cache entry that satisfies
- * it is returned without rendering; otherwise rendering continues from the stored accumulator
- * (samples [N, ...)) or starts from zero, and the result is stored, as "partial" when
- * cancelled. A corrupt entry is reported in `warnings` and rendered again. `cache` may be null
- * (no cache). Throws gilab::Error when no stop criterion is set.
+ * The reference for (scene, settings) meeting `stop`. With a cache, the key's lock is held
+ * throughout, so of several processes sharing the cache one renders and the others wait and
+ * then reuse its entry (a cancel while waiting returns reason Cancelled with no samples). A
+ * complete cache entry that satisfies it is returned without rendering; otherwise rendering
+ * continues from the stored accumulator (samples [N, ...)) or starts from zero, and the result is
+ * stored, as "partial" when cancelled. A corrupt entry is reported in `warnings` and rendered
+ * again. `cache` may be null (no cache). Throws gilab::Error when no stop criterion is set.
  */
 ReferenceResult obtainReference(const Scene& scene, const ReferenceSettings& settings,
                                 const StopCriteria& stop, const ReferenceCache* cache,

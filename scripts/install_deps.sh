@@ -13,6 +13,7 @@ PACKAGES=(
     libcli11-dev libxxhash-dev
     python3-matplotlib chromium fonts-dejavu-core
     libgtest-dev libgmock-dev
+    slurm-wlm munge  # the cluster tests start a one-node Slurm (docs/cluster.md)
 )
 
 missing=()

@@ -2,11 +2,13 @@
 // `gilab reference` end to end (docs/reference_cache.md). Tiny images, few samples.
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -18,6 +20,7 @@
 #include "core/image/image_io.h"
 #include "core/scene/scene_loader.h"
 #include "core/util/error.h"
+#include "core/util/file_lock.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/interrupt.h"
 #include "reference/bench.h"
@@ -307,6 +310,53 @@ TEST(CpuObtainReference, SecondIdenticalRequestRendersNothing) {
             .cacheHit);
     EXPECT_THROW(ref::obtainReference(tinyScene(), tinySettings(), ref::StopCriteria{}, &cache),
                  Error);
+}
+
+TEST(CpuObtainReference, ConcurrentRequestsRenderOnceAndShareTheEntry) {
+    // Three obtainers of one key at once (flock conflicts between separate opens, so threads
+    // stand in for processes): one renders, the others wait for its lock and reuse the entry
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    std::vector<ref::ReferenceResult> results(3);
+    std::vector<std::thread> threads;
+    for (size_t i = 0; i < results.size(); ++i)
+        threads.emplace_back([&, i] {
+            results[i] = ref::obtainReference(tinyScene(), tinySettings(), samplesStop(16), &cache);
+        });
+    for (std::thread& t : threads)
+        t.join();
+    int rendered = 0;
+    for (const ref::ReferenceResult& r : results) {
+        EXPECT_TRUE(r.complete);
+        EXPECT_EQ(r.acc.samples, 16u);
+        EXPECT_TRUE(bitEqual(r.acc, results[0].acc));
+        rendered += r.renderedSamples > 0 ? 1 : 0;
+        EXPECT_EQ(r.cacheHit, r.renderedSamples == 0);
+    }
+    EXPECT_EQ(rendered, 1);
+    EXPECT_TRUE(std::filesystem::exists(cache.lockPath(results[0].key)));
+}
+
+TEST(CpuObtainReference, WaitingForAnotherRendererCanBeCancelled) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    const std::string key = ref::referenceKey(tinyScene(), tinySettings());
+    std::optional<FileLock> held = FileLock::tryAcquire(cache.lockPath(key));
+    ASSERT_TRUE(held);
+    std::atomic<bool> cancel{false};
+    std::thread canceller([&] {
+        std::this_thread::sleep_for(std::chrono::milliseconds(300));
+        cancel = true;
+    });
+    ref::ObtainOptions options;
+    options.cancel = &cancel;
+    const ref::ReferenceResult r =
+        ref::obtainReference(tinyScene(), tinySettings(), samplesStop(8), &cache, options);
+    canceller.join();
+    EXPECT_EQ(r.reason, ref::StopReason::Cancelled);
+    EXPECT_FALSE(r.complete);
+    EXPECT_EQ(r.renderedSamples, 0u);
+    EXPECT_FALSE(std::filesystem::exists(cache.entryDir(key)));
 }
 
 TEST(CpuObtainReference, MoreSamplesContinueAndEqualAFreshRender) {

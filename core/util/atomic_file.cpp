@@ -6,11 +6,12 @@
 #include <fstream>
 
 #include "core/util/error.h"
+#include "core/util/file_lock.h"
 
 namespace gilab {
 
 void writeFileAtomic(const std::filesystem::path& path, const std::string& contents) {
-    const std::filesystem::path tmp = path.string() + ".tmp-" + std::to_string(::getpid());
+    const std::filesystem::path tmp = path.string() + ".tmp-" + processTag();
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
         out << contents;

@@ -5,7 +5,7 @@
 
 namespace gilab {
 
-/** Writes to "<path>.tmp-<pid>", flushes and fsyncs it, then renames it over `path`. */
+/** Writes to "<path>.tmp-<host>-<pid>", flushes and fsyncs it, then renames it over `path`. */
 void writeFileAtomic(const std::filesystem::path& path, const std::string& contents);
 
 }  // namespace gilab

@@ -331,6 +331,9 @@ int runMain(int argc, char** argv) {
                      "Enable Vulkan validation layers (any message: the run is invalid, exit "
                      "code 5 at the end)");
     runCmd->add_flag("--dry-run", run.dryRun, "List the runs and which are finished; run nothing");
+    runCmd->add_flag("--references-only", run.referencesOnly,
+                     "Render (or find in the cache) the config's distinct references, sharded "
+                     "by reference with --shard; no runs, no Vulkan device (docs/cluster.md)");
     runCmd->add_flag("--quiet,-q", run.quiet, "No progress lines");
 
     audit::AuditOptions auditOptions;
@@ -362,6 +365,40 @@ int runMain(int argc, char** argv) {
         "--no-validation", auditNoValidation,
         "Run without the Vulkan validation layers (default: on; any message is red)");
     auditCmd->add_flag("--quiet,-q", auditOptions.quiet, "No progress lines");
+
+    SlurmOptions slurm;
+    slurm.commandLine = commandLine;
+    CLI::App* slurmCmd = app.add_subcommand(
+        "slurm",
+        "Submit an experiment to Slurm: a job array rendering each reference once, a job array "
+        "of `gilab run --shard i/N`, then `gilab report` (docs/cluster.md)");
+    slurmCmd->add_option("config", slurm.configPath, "Experiment config (.json)")
+        ->required()
+        ->check(CLI::ExistingFile);
+    slurmCmd->add_option("--shards", slurm.shards, "Array tasks running the runs")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 100000));
+    slurmCmd
+        ->add_option("--reference-shards", slurm.referenceShards,
+                     "Array tasks rendering references (default: one per reference, at most "
+                     "--shards)")
+        ->check(CLI::Range(1, 100000));
+    slurmCmd->add_option("--partition,-p", slurm.partition, "sbatch --partition");
+    slurmCmd->add_option("--time,-t", slurm.time, "sbatch --time of each task, e.g. 02:00:00");
+    slurmCmd->add_option("--gres", slurm.gres,
+                         "sbatch --gres for the run tasks, e.g. gpu:1 (each task then uses the "
+                         "Vulkan device of CUDA_VISIBLE_DEVICES; without it: lavapipe)");
+    slurmCmd->add_option("--cpus-per-task,-c", slurm.cpusPerTask, "sbatch --cpus-per-task")
+        ->capture_default_str()
+        ->check(CLI::Range(1, 4096));
+    slurmCmd->add_option("--sbatch-arg", slurm.sbatchArgs,
+                         "Another sbatch option for every job, e.g. --sbatch-arg=--account=X "
+                         "(repeatable)");
+    slurmCmd->add_option("--out,-o", slurm.outRoot, "Results root (on the shared file system)")
+        ->capture_default_str();
+    slurmCmd->add_option("--reference-cache", slurm.referenceCacheDir,
+                         "Reference cache on the shared file system (default: as gilab run)");
+    slurmCmd->add_flag("--dry-run", slurm.dryRun, "Print the sbatch scripts; submit nothing");
 
     std::vector<std::string> reportDirs;
     std::string reportOut;
@@ -428,6 +465,7 @@ int runMain(int argc, char** argv) {
             return runExperimentCommand(run);
         }
         if (*reportCmd) return runReport(reportDirs, reportOut);
+        if (*slurmCmd) return runSlurm(slurm);
         if (*auditCmd) {
             auditOptions.validation = !auditNoValidation;
             return runAuditCommand(auditOptions);

@@ -136,6 +136,23 @@ int runExperimentCommand(const exp::RunnerOptions& options);
 /** `gilab report DIR...`: runs scripts/report/make_report.py with Debian's python3. */
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir);
 
+/** `gilab slurm CONFIG`: see experiments/cli/slurm_command.cpp and docs/cluster.md. */
+struct SlurmOptions {
+    std::string configPath;
+    int shards = 4;
+    int referenceShards = 0;  // 0 = one per reference, at most `shards`
+    std::string partition;
+    std::string time;
+    std::string gres;
+    int cpusPerTask = 2;
+    std::vector<std::string> sbatchArgs;
+    std::string outRoot = "results";
+    std::string referenceCacheDir;  // "" = ReferenceCache::defaultDir()
+    bool dryRun = false;
+    std::string commandLine;
+};
+int runSlurm(const SlurmOptions& options);
+
 int runList(bool json);
 int runDevices(const std::string& device);
 int runSceneInfo(const std::string& scenePath, bool json);

@@ -26,11 +26,20 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
         "(a second Ctrl-C or SIGTERM aborts)\n");
     const exp::RunnerSummary s = exp::runExperiment(options, &interrupt.flag());
     if (options.dryRun) return kExitOk;
+    if (options.referencesOnly) {
+        std::printf("%s: %zu distinct references (%zu in this shard): %zu rendered here%s\n",
+                    s.dir.string().c_str(), s.referencesTotal, s.referencesInShard,
+                    s.referencesRendered, s.cancelled ? ", interrupted" : "");
+        return s.cancelled || interrupt.interrupted() ? kExitInterrupted : kExitOk;
+    }
+    if (s.rowsRepaired > 0)
+        std::printf("%s: %zu finished runs had no row in results.jsonl; added\n",
+                    s.dir.string().c_str(), s.rowsRepaired);
     std::printf(
-        "%s: %zu runs (%zu in this shard): %zu already finished, %zu ran (%zu unsupported, "
-        "%zu with non-finite pixels, %zu invalid)%s\n",
-        s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.ran, s.unsupported,
-        s.nonfinite, s.invalid, s.cancelled ? ", interrupted" : "");
+        "%s: %zu runs (%zu in this shard): %zu already finished, %zu finished by another "
+        "process, %zu ran (%zu unsupported, %zu with non-finite pixels, %zu invalid)%s\n",
+        s.dir.string().c_str(), s.total, s.inShard, s.alreadyFinished, s.doneElsewhere, s.ran,
+        s.unsupported, s.nonfinite, s.invalid, s.cancelled ? ", interrupted" : "");
     if (s.invalid > 0)
         std::fprintf(stderr,
                      "gilab: %zu invalid runs: Vulkan validation reported errors or warnings "

@@ -245,12 +245,22 @@ bool RunStore::isFinished(const std::string& key) const {
     return isFinalStatus(storedStatus(key));
 }
 
+std::optional<FileLock> RunStore::tryClaim(const std::string& key) const {
+    return FileLock::tryAcquire(m_dir / "runs" / ".locks" / (key + ".lock"));
+}
+
+std::optional<FileLock> RunStore::claim(const std::string& key,
+                                        const std::atomic<bool>* cancel) const {
+    return FileLock::acquire(m_dir / "runs" / ".locks" / (key + ".lock"), cancel);
+}
+
 fs::path RunStore::beginRun(const std::string& key) const {
     for (const auto& entry : fs::directory_iterator(m_dir / "runs")) {
         const std::string name = entry.path().filename().string();
-        if (name.rfind(".tmp-" + key, 0) == 0) fs::remove_all(entry.path());
+        if (name.rfind(".tmp-" + key + "-", 0) == 0 || name.rfind(".old-" + key + "-", 0) == 0)
+            fs::remove_all(entry.path());
     }
-    const fs::path tmp = m_dir / "runs" / (".tmp-" + key + "-" + std::to_string(::getpid()));
+    const fs::path tmp = m_dir / "runs" / (".tmp-" + key + "-" + processTag());
     fs::create_directories(tmp);
     return tmp;
 }
@@ -258,7 +268,7 @@ fs::path RunStore::beginRun(const std::string& key) const {
 void RunStore::commitRun(const fs::path& tmpDir, const std::string& key) const {
     const fs::path target = runDir(key);
     if (fs::exists(target)) {
-        const fs::path aside = m_dir / "runs" / (".old-" + key + "-" + std::to_string(::getpid()));
+        const fs::path aside = m_dir / "runs" / (".old-" + key + "-" + processTag());
         fs::rename(target, aside);
         fs::rename(tmpDir, target);
         fs::remove_all(aside);
@@ -268,8 +278,32 @@ void RunStore::commitRun(const fs::path& tmpDir, const std::string& key) const {
 }
 
 void RunStore::appendRow(const nlohmann::ordered_json& row) const {
+    const std::optional<FileLock> lock = FileLock::acquire(m_dir / ".locks" / "results.lock");
     appendLine(m_dir / "results.jsonl", row.dump());
     writeCsv();
+}
+
+size_t RunStore::addMissingRows() const {
+    const std::optional<FileLock> lock = FileLock::acquire(m_dir / ".locks" / "results.lock");
+    std::unordered_set<std::string> listed;
+    {
+        std::ifstream in(m_dir / "results.jsonl");
+        std::string line;
+        while (std::getline(in, line)) {
+            try {
+                listed.insert(nlohmann::json::parse(line).value("key", std::string()));
+            } catch (const std::exception&) {
+            }
+        }
+    }
+    size_t added = 0;
+    for (const nlohmann::json& result : loadFinished()) {
+        if (listed.count(result.value("key", std::string()))) continue;
+        appendLine(m_dir / "results.jsonl", resultRow(nlohmann::ordered_json(result)).dump());
+        ++added;
+    }
+    if (added) writeCsv();
+    return added;
 }
 
 void RunStore::writeCsv() const {

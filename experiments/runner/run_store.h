@@ -3,23 +3,29 @@
  * results/<experiment>/: results that are never lost.
  *
  *   runs/<key>/result.json   one folder per finished run (plus its EXR, PNGs, FLIP map)
- *   runs/.tmp-<key>-<pid>/   a run in progress; renamed to runs/<key>/ only when complete, so a
- *                            killed run never leaves a folder that looks finished
+ *   runs/.tmp-<key>-<host>-<pid>/  a run in progress; renamed to runs/<key>/ only when
+ *                            complete, so a killed run never leaves a folder that looks finished
+ *   runs/.locks/<key>.lock   held (flock) by the one process running <key>
+ *   .locks/results.lock      held while a row is appended to the tables
  *   references/<label>/      the bounce-matched reference images each run was compared with
  *   results.jsonl            append-only table, one JSON object per finished run
  *   results.csv              the same rows as CSV (flat columns)
  * A run's key is a hash of its resolved configuration: re-running a config skips keys whose
- * folder holds a finished result.json and redoes only what changed.
+ * folder holds a finished result.json and redoes only what changed. Any number of processes
+ * (shards, nodes of a cluster) may share the folder (docs/cluster.md).
  */
+#include <atomic>
 #include <cstddef>
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include <nlohmann/json.hpp>
 
 #include "core/util/atomic_file.h"
+#include "core/util/file_lock.h"
 
 namespace gilab::exp {
 
@@ -34,13 +40,23 @@ public:
     /** True when runs/<key>/result.json exists and records a final status. */
     bool isFinished(const std::string& key) const;
 
-    /** A fresh temporary folder for a run (stale ones of this key are removed first). */
+    /** The run's lock if no other process holds it (FileLock::tryAcquire). */
+    std::optional<FileLock> tryClaim(const std::string& key) const;
+    /** Waits for the run's lock (nullopt if `cancel` became true first). */
+    std::optional<FileLock> claim(const std::string& key, const std::atomic<bool>* cancel) const;
+
+    /** A fresh temporary folder for a run. The caller holds the run's claim, so any other
+     *  temporary folder of this key is left by a dead process and is removed first. */
     std::filesystem::path beginRun(const std::string& key) const;
     /** Moves the temporary folder to runs/<key>/ (atomic rename). */
     void commitRun(const std::filesystem::path& tmpDir, const std::string& key) const;
 
-    /** Appends one row to results.jsonl (flushed and synced) and rewrites results.csv. */
+    /** Appends one row to results.jsonl (flushed and synced) and rewrites results.csv, under
+     *  the tables' lock. */
     void appendRow(const nlohmann::ordered_json& row) const;
+    /** Adds the row of every finished run folder that results.jsonl lacks (a process killed
+     *  between committing a run and appending its row); returns how many. */
+    size_t addMissingRows() const;
     /** results.csv from results.jsonl: one column per key of any row (atomic rewrite). */
     void writeCsv() const;
 

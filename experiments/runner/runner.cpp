@@ -8,6 +8,8 @@
 #include <memory>
 #include <optional>
 
+#include <unistd.h>
+
 #include "core/image/image_io.h"
 #include "core/passes/shared_passes.h"
 #include "core/scene/animation.h"
@@ -121,26 +123,81 @@ struct Context {
  *  (not committed) and the experiment stops like at a run boundary. */
 struct ReferenceInterrupted {};
 
-/** The reference of `scene` (frame `frame` of an animated entry; -1 = the static scene). */
-const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene,
-                                 int frame = -1) {
-    const std::string id = frame < 0 ? entry.label : entry.label + "@" + std::to_string(frame);
-    auto it = c.references.find(id);
-    if (it != c.references.end()) return *it->second;
+/** "<label>" or "<label>@<frame>": how a reference is named in logs and --references-only. */
+std::string referenceId(const SceneEntry& entry, int frame) {
+    return frame < 0 ? entry.label : entry.label + "@" + std::to_string(frame);
+}
+
+/**
+ * The complete reference of `scene` from the cache, rendered (or continued) if needed. Under
+ * the cache's lock for its key, so processes sharing the cache render it once (the others wait
+ * and reuse it). One log line says which: "rendered reference KEY" or "reused reference KEY".
+ */
+ref::ReferenceResult obtainSceneReference(const ExperimentConfig& config,
+                                          const RunnerOptions& options, ref::ReferenceCache* cache,
+                                          const std::atomic<bool>* cancel, const Scene& scene,
+                                          const std::string& id) {
     ref::ObtainOptions opts;
-    opts.cancel = c.cancel;
+    opts.cancel = cancel;
     opts.sidecarExtra["scene"] = cli::sceneToJson(scene);
-    opts.sidecarExtra["provenance"] = cli::provenanceJson(c.options.commandLine);
+    opts.sidecarExtra["provenance"] = cli::provenanceJson(options.commandLine);
     std::fprintf(stderr, "[gilab] reference for %s\n", id.c_str());
-    ref::ReferenceResult r = ref::obtainReference(scene, c.config.reference.settings,
-                                                  c.config.reference.stop, c.cache, opts);
+    ref::ReferenceResult r =
+        ref::obtainReference(scene, config.reference.settings, config.reference.stop, cache, opts);
     for (const std::string& w : r.warnings)
         std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
     if (r.reason == ref::StopReason::Cancelled) throw ReferenceInterrupted{};  // partial: cached
     if (!r.complete)
         throw Error("reference for " + id + " was interrupted (" + ref::stopReasonName(r.reason) +
                     "); runs need a complete reference");
+    if (r.renderedSamples > 0)
+        std::fprintf(stderr, "[gilab] rendered reference %s for %s: %llu samples in %.1f s\n",
+                     r.key.c_str(), id.c_str(), (unsigned long long)r.renderedSamples,
+                     r.report.seconds);
+    else
+        std::fprintf(stderr, "[gilab] reused reference %s for %s (%llu samples)\n", r.key.c_str(),
+                     id.c_str(), (unsigned long long)r.acc.samples);
+    return r;
+}
+
+/** The reference of `scene` (frame `frame` of an animated entry; -1 = the static scene). */
+const ReferenceSet& referenceFor(Context& c, const SceneEntry& entry, const Scene& scene,
+                                 int frame = -1) {
+    const std::string id = referenceId(entry, frame);
+    auto it = c.references.find(id);
+    if (it != c.references.end()) return *it->second;
+    ref::ReferenceResult r =
+        obtainSceneReference(c.config, c.options, c.cache, c.cancel, scene, id);
     return *c.references.emplace(id, std::make_unique<ReferenceSet>(std::move(r))).first->second;
+}
+
+/** One reference the runs of a config compare with. */
+struct ReferenceTask {
+    const SceneEntry* entry;
+    int frame;  // -1: the static scene
+};
+
+/** The distinct references of `runs`: each scene entry's, then its animation frames'. */
+std::vector<ReferenceTask> referenceTasks(const ExperimentConfig& config,
+                                          const std::vector<RunSpec>& runs, SceneCache& scenes) {
+    std::vector<ReferenceTask> tasks;
+    std::vector<std::string> seen;
+    for (const RunSpec& r : runs) {
+        if (std::find(seen.begin(), seen.end(), r.scene->label) != seen.end()) continue;
+        seen.push_back(r.scene->label);
+        tasks.push_back({r.scene, -1});
+        const Scene& scene = scenes.get(*r.scene);
+        if (scene.animation.animated())
+            for (int f : measuredFrames(scene.animation.frameCount, config.reference.frameStep))
+                tasks.push_back({r.scene, f});
+    }
+    return tasks;
+}
+
+std::string hostName() {
+    char host[256] = {};
+    if (::gethostname(host, sizeof host - 1) != 0) return "";
+    return host;
 }
 
 /**
@@ -301,6 +358,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["provenance"] = cli::provenanceJson(c.options.commandLine);
     result["config_hash"] = c.configHash;
     result["device"] = cli::deviceJson(c.vk);
+    result["host"] = hostName();  // the report groups timings by device and names the nodes
 
     // Destroyed before the validation messages are collected, so they include its teardown.
     auto harness =
@@ -444,6 +502,48 @@ void printDryRun(const std::vector<const RunSpec*>& runs, const std::vector<std:
 
 }  // namespace
 
+namespace {
+
+/** --references-only: the shard's share of the config's distinct references, each obtained
+ *  under the cache's lock (rendered once, whoever asks). */
+RunnerSummary renderReferences(const ExperimentConfig& config, const std::vector<RunSpec>& runs,
+                               const RunnerOptions& options, const std::atomic<bool>* cancel,
+                               RunnerSummary summary) {
+    SceneCache scenes;
+    const std::vector<ReferenceTask> tasks = referenceTasks(config, runs, scenes);
+    summary.referencesTotal = tasks.size();
+    ref::ReferenceCache cache(options.referenceCacheDir.empty()
+                                  ? ref::ReferenceCache::defaultDir()
+                                  : fs::path(options.referenceCacheDir));
+    for (size_t i = 0; i < tasks.size(); ++i) {
+        if (int(i % size_t(options.shardCount)) != options.shardIndex) continue;
+        ++summary.referencesInShard;
+        if (options.dryRun) {
+            std::printf("reference %zu: %s\n", i,
+                        referenceId(*tasks[i].entry, tasks[i].frame).c_str());
+            continue;
+        }
+        if (cancel && cancel->load()) {
+            summary.cancelled = true;
+            break;
+        }
+        const Scene& base = scenes.get(*tasks[i].entry);
+        const Scene scene = tasks[i].frame < 0 ? base : sceneAtFrame(base, tasks[i].frame);
+        try {
+            const ref::ReferenceResult r =
+                obtainSceneReference(config, options, &cache, cancel, scene,
+                                     referenceId(*tasks[i].entry, tasks[i].frame));
+            if (r.renderedSamples > 0) ++summary.referencesRendered;
+        } catch (const ReferenceInterrupted&) {
+            summary.cancelled = true;
+            break;
+        }
+    }
+    return summary;
+}
+
+}  // namespace
+
 std::pair<int, int> parseShard(const std::string& text) {
     const size_t slash = text.find('/');
     int i = -1, n = 0;
@@ -478,6 +578,8 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
                                          {"gilab_version", build::kVersion},
                                          {"git_commit", build::kGitCommit}};
 
+    if (options.referencesOnly) return renderReferences(config, runs, options, cancel, summary);
+
     std::vector<const RunSpec*> mine;
     for (const RunSpec& r : runs)
         if (int(r.index % size_t(options.shardCount)) == options.shardIndex) mine.push_back(&r);
@@ -492,6 +594,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
         return summary;
     }
 
+    summary.rowsRepaired = store.addMissingRows();
     size_t pending = 0;
     for (const std::string& key : keys)
         pending += store.isFinished(key) ? 0 : 1;
@@ -522,28 +625,71 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
 
     Context c{config, options, store, vk,     cache.get(),
               {},     {},      {},    cancel, experiment["config_hash"].get<std::string>()};
-    for (size_t i = 0; i < mine.size(); ++i) {
-        if (cancel && cancel->load()) {
-            summary.cancelled = true;
-            break;
-        }
+    // Each run is claimed (its lock) before it starts, so processes sharing the folder never
+    // run the same key at once. Runs another process holds are deferred, then waited for at
+    // the end: when this process exits, every run of its shard is finished (docs/cluster.md).
+    std::vector<size_t> deferred;
+    auto attempt = [&](size_t i, std::optional<FileLock> claim) {
         if (store.isFinished(keys[i])) {
-            ++summary.alreadyFinished;
-            continue;
+            ++(claim ? summary.alreadyFinished : summary.doneElsewhere);
+            return true;
         }
         std::string status;
         try {
             status = executeRun(c, *mine[i], keys[i], i + 1, mine.size());
         } catch (const ReferenceInterrupted&) {
             summary.cancelled = true;  // nothing of this run is committed; the next run redoes it
-            break;
+            return false;
         }
         ++summary.ran;
         if (status == "unsupported") ++summary.unsupported;
         if (status == "nonfinite") ++summary.nonfinite;
         if (status == "invalid") ++summary.invalid;
+        return true;
+    };
+    for (size_t i = 0; i < mine.size(); ++i) {
+        if (cancel && cancel->load()) {
+            summary.cancelled = true;
+            return summary;
+        }
+        if (store.isFinished(keys[i])) {
+            ++summary.alreadyFinished;
+            continue;
+        }
+        std::optional<FileLock> claim = store.tryClaim(keys[i]);
+        if (!claim) {
+            deferred.push_back(i);
+            continue;
+        }
+        if (!attempt(i, std::move(claim))) return summary;
+    }
+    for (size_t i : deferred) {
+        if (!store.isFinished(keys[i]))
+            std::fprintf(stderr, "[gilab] run %zu is running in another process; waiting for it\n",
+                         mine[i]->index);
+        std::optional<FileLock> claim = store.claim(keys[i], cancel);
+        if (!claim) {
+            summary.cancelled = true;
+            return summary;
+        }
+        // Finished by the other process: counted as done elsewhere; else (it died) run it here
+        const bool finishedThere = store.isFinished(keys[i]);
+        if (finishedThere) {
+            ++summary.doneElsewhere;
+            continue;
+        }
+        if (!attempt(i, std::move(claim))) return summary;
     }
     return summary;
+}
+
+std::vector<std::string> listReferences(const std::string& configPath) {
+    const ExperimentConfig config = loadExperimentConfig(configPath);
+    SceneCache scenes;
+    std::vector<std::string> ids;
+    for (const ReferenceTask& t : referenceTasks(config, expandRuns(config), scenes))
+        ids.push_back(referenceId(*t.entry, t.frame));
+    return ids;
 }
 
 }  // namespace gilab::exp

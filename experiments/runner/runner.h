@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace gilab::exp {
 
@@ -23,6 +24,10 @@ struct RunnerOptions {
     bool quiet = false;
     std::string referenceCacheDir;  // "" = ReferenceCache::defaultDir()
     bool dryRun = false;            // list the runs and whether each is done; run nothing
+    /** --references-only: render (or find) the distinct references of the config, the
+     *  shard's share of them (reference i of the list when i % N == shard); no run, no
+     *  Vulkan device. The first step of `gilab slurm` (docs/cluster.md). */
+    bool referencesOnly = false;
     std::string commandLine;
 };
 
@@ -36,8 +41,17 @@ struct RunnerSummary {
     size_t nonfinite = 0;
     size_t invalid = 0;  // runs with Vulkan validation messages (stored, redone next time)
     uint32_t validationOutsideRuns = 0;  // messages before the runs (the timestamp probe)
+    size_t doneElsewhere = 0;       // runs another process (shard, node) was running; waited for
+    size_t rowsRepaired = 0;        // finished runs whose table row was missing (addMissingRows)
+    size_t referencesTotal = 0;     // --references-only: distinct references of the config
+    size_t referencesInShard = 0;   // ... of this shard
+    size_t referencesRendered = 0;  // ... rendered (or continued) by this process
     bool cancelled = false;
 };
+
+/** The distinct references the runs of a config compare with, as "<scene label>" or
+ *  "<scene label>@<frame>" (animation frames), in the order --references-only shards them. */
+std::vector<std::string> listReferences(const std::string& configPath);
 
 RunnerSummary runExperiment(const RunnerOptions& options,
                             const std::atomic<bool>* cancel = nullptr);

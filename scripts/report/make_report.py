@@ -22,8 +22,9 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import report_figures  # noqa: E402
 from report_analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,  # noqa: E402
-                             best_runs, by_scene, find_sweeps, has_one_bounce, pareto_fronts,
-                             pareto_ties, pass_colors, scene_basis, slug, technique_colors)
+                             best_runs, by_device, by_scene, find_sweeps, has_one_bounce,
+                             pareto_fronts, pareto_ties, pass_colors, scene_basis, slug,
+                             technique_colors)
 from report_noop import no_effect  # noqa: E402
 from report_data import Results, Run, load_results  # noqa: E402
 from report_common import Figures, Page  # noqa: E402
@@ -120,6 +121,17 @@ def write_figures(results: Results, colors: dict[str, str], fig_dir: str) -> Fig
     return figures
 
 
+def page_fronts(runs: list[Run], basis: Basis) -> tuple[dict, dict]:
+    """A scene's Pareto fronts and ties (Page.fronts, Page.ties) by comparable group, of each
+    device model apart when its runs were timed on several (keys '<group> on <device>')."""
+    fronts, ties = {}, {}
+    for device, members in by_device(runs).items():
+        on = f" on {device}" if device else ""
+        fronts.update({label + on: f for label, f in pareto_fronts(members, basis).items()})
+        ties.update({label + on: t for label, t in pareto_ties(members, basis).items()})
+    return fronts, ties
+
+
 def tool_versions() -> str:
     import matplotlib  # already imported by report_figures; only for its version
 
@@ -135,9 +147,10 @@ def build_report(dirs: list[str], out_dir: str) -> str:
     figures = write_figures(results, colors, os.path.join(out_dir, "figures"))
     scenes = by_scene(results.runs)
     bases = {scene: scene_basis(rs) for scene, rs in scenes.items()}
+    fronts = {s: page_fronts(rs, bases[s]) for s, rs in scenes.items()}
     page = Page(out_dir=out_dir, results=results, colors=colors, figures=figures, bases=bases,
-                fronts={s: pareto_fronts(rs, bases[s]) for s, rs in scenes.items()},
-                ties={s: pareto_ties(rs, bases[s]) for s, rs in scenes.items()},
+                fronts={s: f for s, (f, _) in fronts.items()},
+                ties={s: t for s, (_, t) in fronts.items()},
                 docs_dir=REPO_DOCS if os.path.isdir(REPO_DOCS) else None,
                 generated=datetime.datetime.now(datetime.timezone.utc)
                 .strftime("%Y-%m-%dT%H:%M:%SZ"),

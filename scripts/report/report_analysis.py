@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
 from report_data import Animation, MetricView, Run, num, text
+from report_device import device_group, device_groups
 from report_noise import front_ties
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
@@ -279,6 +280,15 @@ def comparable_groups(runs: list[Run], basis: Basis,
     return {label: members for label, members in sorted(groups.items(),
                                                         key=lambda kv: (len(kv[0]), kv[0]))
             if len(members) >= MIN_COMPARED}
+
+
+def by_device(runs: list[Run]) -> dict[str, list[Run]]:
+    """The runs by the device model they were timed on when the measured ones were timed on
+    several (their times are never compared), else {'': runs}."""
+    devices = device_groups([r for r in runs if r.measured and r.frame_ms is not None])
+    if len(devices) < 2:
+        return {"": runs}
+    return {device: [r for r in runs if device_group(r) == device] for device in devices}
 
 
 def pareto_fronts(runs: list[Run], basis: Basis,

@@ -329,6 +329,8 @@ class Run:
     claimed_bounces: Optional[int] = None  # technique.indirect_bounces (-1 = all)
     device_type: str = ""  # device.type: "cpu" (lavapipe), "discrete", "integrated", ...
     device_driver: str = ""  # device.driver
+    device_name: str = ""  # device.name: "NVIDIA H200", "llvmpipe (LLVM 15.0.6, 256 bits)"
+    host: str = ""  # the node it ran on (short hostname); "" = unknown
     # The static frame (timing.frame_gpu_ms, else frame_cpu_ms), whatever the ranking clock is.
     static: TimeSummary = field(default_factory=TimeSummary)
     anim: Optional[Animation] = None  # None: a static scene's run
@@ -448,6 +450,16 @@ def _as_dict(value: Any) -> dict:
     return value if isinstance(value, dict) else {}
 
 
+def _host(data: dict) -> str:
+    """The top-level "host"; older results only have provenance.host (cut to its short
+    name); '' when neither is a non-empty string."""
+    host = data.get("host")
+    if isinstance(host, str) and host:
+        return host
+    host = dig(data, "provenance", "host")
+    return host.split(".")[0] if isinstance(host, str) else ""
+
+
 def parse_run(data: dict, folder: str, results_dir: str) -> Run:
     """A Run from a parsed result.json (never raises on missing or odd values)."""
     frame, source = _frame_summary(data)
@@ -492,6 +504,8 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
                          else None),
         device_type=text(dig(data, "device", "type")),
         device_driver=text(dig(data, "device", "driver")),
+        device_name=text(dig(data, "device", "name")),
+        host=_host(data),
         static=TimeSummary(num(frame.get("median")), q1, q3, iqr, source),
         anim=parse_animation(data),
     )

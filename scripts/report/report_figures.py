@@ -20,7 +20,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormat
 from report_analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E402
                              by_technique, param_value, params_text, pareto_fronts, pareto_ties,
                              shade, sweep_x)
-from report_device import DYNAMIC_FRAME, device_label, dynamic_clock, time_label  # noqa: E402
+from report_device import (DYNAMIC_FRAME, device_group, device_groups,  # noqa: E402
+                           device_label, dynamic_clock, nodes_phrase, time_label)
 from report_data import Run, Temporal, text  # noqa: E402
 
 STYLE = {
@@ -113,11 +114,13 @@ def _static_marks(ax: plt.Axes, runs: list[Run], colors: dict[str, str], error: 
 
 
 def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis: Basis,
-                   error: Metric, sigma: Metric, ylabel: str) -> None:
+                   error: Metric, sigma: Metric, ylabel: str, ylog: Optional[bool] = None,
+                   front_order: Optional[list[str]] = None) -> None:
     """Error against frame time, one colour per technique, the Pareto front of each group of
     comparable runs as a step line (runs on it ringed; runs tied with it within the noise in a
     dashed grey ring). On an animated scene the time is the dynamic frame's, and each run's
-    static frame is a hollow marker on the same error."""
+    static frame is a hollow marker on the same error. ylog None: a log error axis when this
+    panel's errors span > LOG_SPAN; front_order: the groups in the legend's order (of styles)."""
     plotted = [r for r in runs if r.measured and r.frame_ms is not None and error(r) is not None]
     ax.set_ylabel(ylabel)
     ax.set_xlabel(axis_time_label([r for r in runs if r.measured], "median frame time"))
@@ -141,7 +144,12 @@ def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis:
                 bars.lines[2][0].set_gid(IQR_GID)  # the frame-time IQR bars (x comes first)
     right = max(r.frame_ms for r in plotted)
     styles = FRONT_STYLES if basis.name == "matched" else ("-",)
-    for style, front in zip(styles, pareto_fronts(runs, basis, error).values()):
+    fronts = pareto_fronts(runs, basis, error)
+    order = front_order or list(fronts)
+    for label, front in fronts.items():
+        if label not in order or order.index(label) >= len(styles):
+            continue
+        style = styles[order.index(label)]
         xs = [r.frame_ms for r in front] + [right]
         ys = [error(r) for r in front] + [error(front[-1])]
         ax.step(xs, ys, where="post", color="black", lw=1.0, ls=style, zorder=2)
@@ -154,7 +162,7 @@ def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis:
     if _wants_log([r.frame_ms for r in plotted] + statics):
         ax.set_xscale("log")
         _log_axis(ax.xaxis)
-    if _wants_log([error(r) for r in plotted]):
+    if _wants_log([error(r) for r in plotted]) if ylog is None else ylog:
         ax.set_yscale("log")
         _log_axis(ax.yaxis)
 
@@ -196,7 +204,22 @@ def _row_title(basis: Basis, runs: list[Run], metric: str) -> str:
 def pareto_figure(runs: list[Run], colors: dict[str, str], bases: list[Basis], path: str,
                   scene: str) -> None:
     """Mean HDR-FLIP and relMSE against median frame time for one scene: one row of two panels
-    per basis, the headline basis (the full reference) on top."""
+    per basis, the headline basis (the full reference) on top; one column per device when the
+    runs were timed on more than one (error_time_figure)."""
+    _save(error_time_figure(runs, colors, bases, scene), path)
+
+
+def error_time_figure(runs: list[Run], colors: dict[str, str], bases: list[Basis],
+                      scene: str) -> plt.Figure:
+    """The figure of pareto_figure, not saved. Times of two device models never share an axis:
+    with several, each gets its own column of panels (_device_columns)."""
+    measured = [r for r in runs if r.measured]
+    groups = device_groups([r for r in measured if r.frame_ms is not None])
+    what = "dynamic frame time" if dynamic_clock(measured) else "frame time"
+    if len(groups) > 1:
+        fig = _device_columns(runs, groups, colors, bases, scene, what)
+        _pareto_legend(fig, runs, colors, bases)
+        return fig
     fig, axes = plt.subplots(len(bases), 2, figsize=(10.0, 3.8 * len(bases)), squeeze=False,
                              gridspec_kw={"wspace": 0.25, "hspace": 0.62})
     for row, basis in zip(axes, bases):
@@ -206,14 +229,48 @@ def pareto_figure(runs: list[Run], colors: dict[str, str], bases: list[Basis], p
                        "relMSE ↓")
         _title(row[0], _row_title(basis, runs, "HDR-FLIP"))
         _title(row[1], _row_title(basis, runs, "relMSE"))
-    what = "dynamic frame time" if dynamic_clock([r for r in runs if r.measured]) else \
-        "frame time"
     lines = max(len(textwrap.wrap(_row_title(bases[0], runs, m), 52))
                 for m in ("HDR-FLIP", "relMSE"))
-    fig.suptitle(f"{scene}: error against {what} (top row: the ranking basis)", fontsize=10,
+    title = f"{scene}: error against {what} (top row: the ranking basis)"
+    timed = [r for runs_of_group in groups.values() for r in runs_of_group]
+    if len({r.host for r in timed} - {""}) > 1:  # one device model on several nodes
+        title += f"\ntimed on {next(iter(groups))}, the same model {nodes_phrase(timed)}"
+        lines += 1
+    fig.suptitle(title, fontsize=10,
                  y=(0.94 if len(bases) == 1 else 0.93) + 0.03 * (lines - 1) * (2 / len(bases)))
     _pareto_legend(fig, runs, colors, bases)
-    _save(fig, path)
+    return fig
+
+
+def _device_columns(runs: list[Run], groups: dict[str, list[Run]], colors: dict[str, str],
+                    bases: list[Basis], scene: str, what: str) -> plt.Figure:
+    """One column per device model, each with its own time axis and Pareto fronts, titled with
+    the device and its nodes; one row per basis and metric, the error axis shared along it."""
+    rows = [(b, m) for b in bases for m in ("HDR-FLIP", "relMSE")]
+    height = 3.6 * len(rows)
+    fig, axes = plt.subplots(len(rows), len(groups), figsize=(5.0 * len(groups), height),
+                             squeeze=False, sharey="row",
+                             gridspec_kw={"wspace": 0.2, "hspace": 0.95,
+                                          "top": 1 - 0.9 / height, "bottom": 0.5 / height})
+    matched = list(pareto_fronts(runs, MATCHED))  # the legend's matched fronts, in order
+    for row, (basis, metric) in zip(axes, rows):
+        flip = metric == "HDR-FLIP"
+        error, sigma = (basis.flip, basis.flip_sigma) if flip else \
+            (basis.rel_mse, basis.rel_mse_sigma)
+        ylog = _wants_log([error(r) for r in runs if r.measured and r.frame_ms is not None])
+        for ax, (device, timed) in zip(row, groups.items()):
+            own = [r for r in runs if device_group(r) == device]
+            _scatter_panel(ax, own, colors, basis, error, sigma,
+                           "mean HDR-FLIP ↓" if flip else "relMSE ↓", ylog,
+                           matched if basis.name == "matched" else None)
+            lines = [_row_title(basis, runs, metric), device, nodes_phrase(timed)]
+            ax.set_title("\n".join(textwrap.fill(t, 52) for t in lines if t), fontsize=9)
+            if ax is not row[0]:  # the error axis is shared along the row
+                ax.set_ylabel("")
+    fig.suptitle(f"{scene}: error against {what}, timed on {len(groups)} devices: one column "
+                 "each, never one time axis (top two rows: the ranking basis)", fontsize=10,
+                 y=1.0, va="bottom")
+    return fig
 
 
 def _sweep_positions(sweep: Sweep) -> tuple[dict[str, float], list[str]]:

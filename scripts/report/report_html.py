@@ -9,14 +9,16 @@ from __future__ import annotations
 import os
 from typing import Optional
 
-from report_analysis import Sweep, best_runs, by_scene, param_value, params_text
+from report_analysis import (Sweep, best_runs, by_device, by_scene, param_value,
+                             params_text, pareto_fronts, pareto_ties)
 from report_assets import BODY_JS, CSS, HEAD_JS, MAGMA_STOPS
 from report_animation import animation_anchor, animation_html
 from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, esc,
                            fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
                            rel_url, scene_anchor, status_badge, swatch, update_badge, with_bar)
 from report_data import Run, dig, num, text
-from report_device import DYNAMIC_FRAME, device_label, dynamic_clock, time_label
+from report_device import (DYNAMIC_FRAME, device_groups, device_label, dynamic_clock,
+                           hosts_of, nodes_phrase, time_label)
 from report_noise import change_words, tied_best, time_change_words
 from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
                            invalid_banner_html, run_table_html, skipped_html, unreadable_html)
@@ -260,11 +262,12 @@ def figure_html(path: str, page: Page, alt: str, caption: str) -> str:
             f'onerror="gilabImageError(this)"></a><figcaption>{caption}</figcaption></figure>')
 
 
-def _front_table(front: list[Run], page: Page, scene: str, group: str) -> str:
+def _front_table(front: list[Run], page: Page, scene: str, group: str, ties: dict[int, Run],
+                 compared: list[Run]) -> str:
     """The front's runs, then the runs tied with it (inseparable within IQR and error bars);
-    every number in the error column is the scene's one basis (data-basis names it)."""
+    every number in the error column is the scene's one basis (data-basis names it). compared:
+    the runs the front was taken over (those of one device when the scene has several)."""
     basis = page.basis(scene)
-    ties = page.ties.get(scene, {}).get(group, {})
     runs = page.results.runs
     tied = [r for r in runs if id(r) in ties]
     rows = []
@@ -279,7 +282,7 @@ def _front_table(front: list[Run], page: Page, scene: str, group: str) -> str:
                     f'data-v="{basis.flip(run)!r}">'
                     f"{with_bar(fmt_flip(basis.flip(run)), basis.flip_sigma(run), fmt_flip)}</td>"
                     f"<td>{mark}</td></tr>")
-    measured = [r for r in runs if r.measured and r.scene == scene]
+    measured = [r for r in compared if r.measured]
     return (f'<table class="data ranking" data-basis="{esc(basis.name)}" data-value="error">'
             f'<thead><tr><th>technique</th><th>parameters</th>'
             f'<th>{esc(time_label(measured, "frame time"))} ± IQR</th>'
@@ -308,15 +311,56 @@ def _mixed_references_note(runs: list[Run], page: Page, scene: str) -> str:
             + '</p>')
 
 
+def _timed(runs: list[Run]) -> list[Run]:
+    return [r for r in runs if r.measured and r.frame_ms is not None]
+
+
+def _groups_list(groups: dict[str, list[Run]]) -> str:
+    """'A (3 runs on node01, node02); B (1 run on node03)'."""
+    return "; ".join(f"<b>{esc(device)}</b> ({len(rs)} run{'s' if len(rs) != 1 else ''}"
+                     f"{' ' + esc(nodes_phrase(rs)) if hosts_of(rs) else ''})"
+                     for device, rs in groups.items())
+
+
 def _devices_warning(page: Page) -> str:
     """docs/timing.md: timings from different devices are never mixed without saying so."""
-    devices = sorted({text(dig(r.data, "device", "name")) for r in page.results.runs
-                      if r.measured and dig(r.data, "device", "name")})
-    if len(devices) < 2:
+    groups = device_groups(_timed(page.results.runs))
+    if len(groups) < 2:
         return ""
-    return ('<p class="warn">These runs come from ' + str(len(devices)) + ' devices ('
-            + ", ".join(esc(d) for d in devices) + '): frame times of different devices are '
-            'not comparable, and the figures and tables below mix them.</p>')
+    return (f'<p class="warn">These runs were timed on {len(groups)} devices: '
+            f'{_groups_list(groups)}. Frame times of different devices are not comparable, so '
+            '<b>timings are grouped by device</b>: each figure below has one column of panels '
+            'per device, with its own time axis, and the Pareto fronts (their tables, the run '
+            'table\'s Pareto column) and the equal-time and equal-error tables compare runs of '
+            'one device only. The run table, the sweep and time-per-pass figures and the '
+            'animated-scene tables show the devices\' times side by side: their time headers '
+            'say "mixed devices" and the run table has a device column.</p>')
+
+
+def _devices_caption(runs: list[Run]) -> str:
+    """What the scene's figure says about devices and nodes ('' for one device on one node)."""
+    groups = device_groups(_timed(runs))
+    if len(groups) > 1:
+        return f" Timings are grouped by device, one column each: {_groups_list(groups)}."
+    if len(hosts_of(_timed(runs))) > 1:
+        return (f" Timed on {esc(next(iter(groups)))}, the same device model "
+                f"{esc(nodes_phrase(_timed(runs)))}.")
+    return ""
+
+
+def _front_tables(page: Page, scene: str, runs: list[Run]) -> str:
+    """The Pareto tables under a scene's figure: one per comparable group, of each device apart
+    when the runs were timed on several (as the figure's columns; make_report.page_fronts)."""
+    basis = page.basis(scene)
+    parts = []
+    for device, members in by_device(runs).items():
+        ties = pareto_ties(members, basis)
+        on = f" on {esc(device)}" if device else ""
+        parts += [f'<h4>Pareto-optimal runs{on}: mean <span class="basis">'
+                  f'{esc(basis.label("HDR-FLIP", label))}</span></h4>'
+                  + _front_table(front, page, scene, label, ties.get(label, {}), members)
+                  for label, front in pareto_fronts(members, basis).items()]
+    return "".join(parts)
 
 
 def pareto_html(page: Page) -> str:
@@ -339,16 +383,17 @@ def pareto_html(page: Page) -> str:
     for scene, path in page.figures.pareto.items():
         basis = page.basis(scene)
         parts.append(f"<h3>{esc(scene)}</h3>")
+        runs = scenes.get(scene, [])
+        several = len(device_groups(_timed(runs))) > 1
         parts.append(figure_html(path, page, f"error vs frame time, {scene}",
-                                 f"Top row: {esc(basis.label('HDR-FLIP'))} (left) and "
-                                 f"{esc(basis.label('relMSE'))} (right) against median frame "
-                                 f"time on {esc(scene)}."))
-        parts.append(_mixed_references_note(scenes.get(scene, []), page, scene))
-        fronts = page.fronts.get(scene, {})
-        for label, front in fronts.items():
-            parts.append(f'<h4>Pareto-optimal runs: mean <span class="basis">'
-                         f'{esc(basis.label("HDR-FLIP", label))}</span></h4>'
-                         + _front_table(front, page, scene, label))
+                                 f"{'Top two rows' if several else 'Top row'}: "
+                                 f"{esc(basis.label('HDR-FLIP'))} "
+                                 f"{'and' if several else '(left) and'} "
+                                 f"{esc(basis.label('relMSE'))}{'' if several else ' (right)'} "
+                                 f"against median frame time on {esc(scene)}."
+                                 + _devices_caption(runs)))
+        parts.append(_mixed_references_note(runs, page, scene))
+        parts.append(_front_tables(page, scene, runs))
     return "".join(parts)
 
 

@@ -8,14 +8,14 @@ import os
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from report_analysis import (MIN_COMPARED, best_within_budget, by_scene, by_technique,
-                             cheapest_reaching, comparable_groups, error_targets, ordered_unique,
-                             params_text, slug, time_budgets)
+from report_analysis import (MIN_COMPARED, best_within_budget, by_device, by_scene,
+                             by_technique, cheapest_reaching, comparable_groups, error_targets,
+                             ordered_unique, params_text, slug, time_budgets)
 from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html, fmt_fixed,
                            fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, rel_url,
                            status_badge, swatch, update_badge, validation_summary, with_bar)
 from report_data import Results, Run, dig, num, text
-from report_device import device_note_html, time_label
+from report_device import device_group, device_groups, device_note_html, time_label
 from report_noise import error_separable, time_separable
 
 
@@ -65,7 +65,7 @@ def header_html(page: Page) -> str:
         driver = text(dig(r.data, "device", "driver_info")) or text(dig(r.data, "device", "driver"))
         devices.append(f"{name} ({driver})" if name and driver else name)
     rows.append(("devices", _counted(devices)))
-    rows.append(("hosts", _counted([text(dig(r.data, "provenance", "host")) for r in runs])))
+    rows.append(("hosts", _counted([r.host for r in runs])))
     configs = [f"{esc(p)}" for p in _experiment_field(page, "config_path")]
     hashes = _experiment_field(page, "config_hash")
     if configs or hashes:
@@ -279,6 +279,17 @@ def _relmse_cell(view: Callable[[Run], object]) -> Callable[[Run], tuple[str, ob
     return cell
 
 
+def _device_columns(measured: list[Run]) -> list[Column]:
+    """A device column when the runs were timed on more than one device model."""
+    if len(device_groups([r for r in measured if r.frame_ms is not None])) < 2:
+        return []
+    return [Column("device", "device (node)", "the device model the run's times were measured "
+                   "on (device.name, device.type), and the node it ran on (host)",
+                   lambda r: (esc(device_group(r)) + (f' <span class="muted">({esc(r.host)})'
+                                                      '</span>' if r.host else ""),
+                              device_group(r)), False, "")]
+
+
 def run_columns(page: Page) -> list[Column]:
     """The run table's columns: identity, error (full reference first: the ranking basis),
     then cost; those no run has are dropped."""
@@ -297,6 +308,7 @@ def run_columns(page: Page) -> list[Column]:
         Column("status", "status", "ok / nonfinite / unsupported (with the reason) / invalid "
                "(Vulkan validation reported errors or warnings: numbers not trusted, not ranked)",
                _status_cell, False, "reason"),
+        *_device_columns(measured),
         Column("frame", f"{frame} ± IQR", "median frame time over the timed frames ± IQR "
                "(sum of the passes' timestamps on the device named)"
                + ("; on an animated scene the static frame (nothing moved)" if animated else ""),
@@ -537,15 +549,19 @@ def _left_out_note(runs: list[Run], groups: dict[str, list[Run]], page: Page) ->
 
 def equal_html(page: Page) -> str:
     parts = []
-    for scene, runs in by_scene(page.results.runs).items():
+    for scene, scene_runs in by_scene(page.results.runs).items():
         basis = page.basis(scene)
-        groups = comparable_groups(runs, basis)
-        if not groups:
-            continue
-        parts.append(f"<h3>{esc(scene)}</h3>")
-        for label, ok in groups.items():
-            parts.append(_equal_group_html(page, ok, scene, label))
-        parts.append(_left_out_note(runs, groups, page))
+        tables = []
+        for device, runs in by_device(scene_runs).items():  # one device's times at a time
+            groups = comparable_groups(runs, basis)
+            if not groups:
+                continue
+            if device:
+                tables.append(f'<h4 class="device">Timed on {esc(device)}</h4>')
+            tables += [_equal_group_html(page, ok, scene, label) for label, ok in groups.items()]
+            tables.append(_left_out_note(runs, groups, page))
+        if tables:
+            parts += [f"<h3>{esc(scene)}</h3>"] + tables
     if not parts:
         return ""
     return ('<h2 id="equal">Equal-time and equal-error comparison</h2><p>Per scene, every run '

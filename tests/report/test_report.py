@@ -398,6 +398,136 @@ def check_merge(checks: Checks, tmp: str) -> None:
                  "merge: figures of an earlier report are removed")
 
 
+# Slurm job arrays: one folder, runs timed on two devices (each on its own node), or on one device
+# model on two nodes. Device labels as report_device.device_group writes them.
+FLAT_GPU = "Fixture GPU (synthetic) (GPU)"
+LAVAPIPE_CPU = "llvmpipe (LLVM 15.0.6, 256 bits) (lavapipe, CPU)"
+LAVAPIPE_DEVICE = {"name": "llvmpipe (LLVM 15.0.6, 256 bits)", "type": "cpu",
+                   "driver": "llvmpipe"}
+
+
+def copy_with_devices(source: str, out: str, two_devices: bool) -> None:
+    """A copy of a fixture folder whose runs say where they ran. two_devices: every run on the
+    fixture's GPU on node-a, and again (a copy, key + 'cpu') on lavapipe on node-b; else every
+    run on the GPU, odd indices on node-a and even ones on node-b."""
+    shutil.copytree(source, out, ignore=shutil.ignore_patterns("report.html", "figures"))
+    for name in os.listdir(os.path.join(out, "runs")):
+        folder = os.path.join(out, "runs", name)
+        try:
+            with open(os.path.join(folder, "result.json"), encoding="utf-8") as f:
+                data = json.load(f)
+        except (OSError, ValueError):
+            continue  # the malformed run folder stays as it is
+        data["host"] = "node-a" if two_devices or data.get("index", 0) % 2 else "node-b"
+        copies = [(folder, data)]
+        if two_devices:
+            shutil.copytree(folder, folder + "cpu")
+            copies.append((folder + "cpu", dict(data, key=data.get("key", name) + "cpu",
+                                                 host="node-b", device=LAVAPIPE_DEVICE)))
+        for path, result in copies:
+            with open(os.path.join(path, "result.json"), "w", encoding="utf-8") as f:
+                json.dump(result, f)
+
+
+def error_time_figures(results_dir: str) -> dict[str, tuple[object, int]]:
+    """scene -> (the error-vs-time matplotlib Figure the report draws, built in this process,
+    and its number of bases: a row of two panels each per device)."""
+    if os.path.dirname(REPORT) not in sys.path:
+        sys.path.insert(0, os.path.dirname(REPORT))
+    import make_report as report  # noqa: E402 (the report's own modules)
+    import report_figures
+    from report_analysis import by_scene, technique_colors
+    from report_data import load_results
+
+    runs = load_results([results_dir]).runs
+    colors = technique_colors([r.technique for r in runs])
+    report_figures.configure()
+    return {scene: (report_figures.error_time_figure(rs, colors, report.figure_bases(rs), scene),
+                    len(report.figure_bases(rs))) for scene, rs in by_scene(runs).items()}
+
+
+def panel_titles(fig) -> list[str]:
+    return [ax.get_title().replace("\n", " ") for ax in fig.axes]
+
+
+def suptitle(fig) -> str:
+    title = getattr(fig, "_suptitle", None)
+    return title.get_text().replace("\n", " ") if title is not None else ""
+
+
+def check_devices(checks: Checks, tmp: str) -> None:
+    """Runs timed on two devices get one column of panels per device in every error-vs-time
+    figure, one Pareto table per device and a device column; one device on two nodes keeps one
+    column and names the nodes; one device on one node has neither (the flat fixture)."""
+    import matplotlib.pyplot as plt  # noqa: E402 (Debian's python3-matplotlib)
+
+    flat = os.path.join(tmp, "fixture-flat")  # written by check_no_sweeps
+    mixed, nodes = os.path.join(tmp, "two-devices"), os.path.join(tmp, "two-nodes")
+    copy_with_devices(flat, mixed, True)
+    copy_with_devices(flat, nodes, False)
+    for folder in (mixed, nodes):
+        result = make_report([folder])
+        checks.check(result.returncode == 0, f"{os.path.basename(folder)}: report built",
+                     result.stderr[-600:])
+
+    for scene, (fig, bases) in error_time_figures(mixed).items():
+        titles = panel_titles(fig)
+        checks.check(len(titles) == 4 * bases
+                     and [sum(d in t for t in titles) for d in (FLAT_GPU, LAVAPIPE_CPU)]
+                     == [2 * bases] * 2 and all("on node-" in t for t in titles),
+                     f"two devices, {scene}: one panel per device for each basis and metric, "
+                     "each titled with its device and node", str(titles))
+        checks.check(all(a.get_shared_y_axes().joined(a, b)
+                         for a, b in zip(fig.axes[0::2], fig.axes[1::2]))
+                     and "timed on 2 devices" in suptitle(fig),
+                     f"two devices, {scene}: the error axis is shared along each row, the "
+                     "title says 2 devices")
+        plt.close(fig)
+    for folder in (nodes, flat):
+        name = os.path.basename(folder)
+        for scene, (fig, bases) in error_time_figures(folder).items():
+            words = " ".join(panel_titles(fig) + [suptitle(fig)])
+            checks.check(len(fig.axes) == 2 * bases and FLAT_GPU not in panel_titles(fig)
+                         and "mixed" not in words and "devices" not in words
+                         and ("the same model on 2 nodes: node-a, node-b" in words)
+                         == (folder == nodes),
+                         f"{name}, {scene}: one column pair of panels, no device grouping; the "
+                         "title names the nodes exactly when there are several", words)
+            plt.close(fig)
+
+    svg = "".join(" ".join(page_checks.svg_texts(os.path.join(mixed, "figures", n)))
+                  for n in os.listdir(os.path.join(mixed, "figures")) if n.startswith("pareto_"))
+    checks.check(FLAT_GPU in svg and LAVAPIPE_CPU in svg,
+                 "two devices: the error-vs-time SVGs name both devices")
+    dom = load_dom(checks, tmp, os.path.join(mixed, "report.html"), "two-devices page")
+    text = " ".join(page_checks.strip_tags(dom).split())
+    checks.check("timings are grouped by device" in text.lower() and FLAT_GPU in text
+                 and LAVAPIPE_CPU in text and "on node-a" in text and "on node-b" in text,
+                 "two devices: the page says timings are grouped by device, with both devices "
+                 "and their nodes")
+    checks.check(f"Pareto-optimal runs on {FLAT_GPU}" in text
+                 and f"Pareto-optimal runs on {LAVAPIPE_CPU}" in text
+                 and f'<h4 class="device">Timed on {FLAT_GPU}</h4>' in dom
+                 and f'<h4 class="device">Timed on {LAVAPIPE_CPU}</h4>' in dom,
+                 "two devices: Pareto and equal-time tables of each device apart")
+    items = elements(dom)
+    heads = [page_checks.strip_tags(h) for h in re.findall(r"<th[^>]*>(.*?)</th>", dom, re.S)]
+    checks.check("device" in column_ids(items) and any(
+        h.startswith("frame time, mixed devices: ") and FLAT_GPU in h and LAVAPIPE_CPU in h
+        for h in heads), "two devices: the run table has a device column and its frame-time "
+        "header names both devices")
+    for folder in (nodes, flat):
+        with open(os.path.join(folder, "report.html"), encoding="utf-8") as f:
+            markup = f.read()
+        name = os.path.basename(folder)
+        checks.check("mixed devices" not in markup and "grouped by device" not in markup
+                     and 'data-col="device"' not in markup,
+                     f"{name}: no 'mixed devices', no grouping by device, no device column")
+        checks.check(("the same device model on 2 nodes: node-a, node-b" in markup)
+                     == (folder == nodes), f"{name}: the caption names the nodes exactly when "
+                     "there are several")
+
+
 HOSTILE_RUNS = {
     "minimal": {"status": "ok"},
     "wrong_types": {"status": "ok", "key": 5, "index": "x", "scene": 5, "technique": {
@@ -475,8 +605,9 @@ def main(argv: list[str]) -> int:
     keep = "--keep" in argv
     tmp = tempfile.mkdtemp(prefix="gilab-report-test-")
     start = time.monotonic()
-    # Chains in parallel threads (Chromium mostly waits): the merge needs the main fixture.
-    chains = [[check_main, check_merge], [check_no_sweeps],
+    # Chains in parallel threads (Chromium mostly waits): the merge needs the main fixture,
+    # check_devices the flat one.
+    chains = [[check_main, check_merge], [check_no_sweeps, check_devices],
               [check_detection, check_hostile, check_edges]]
     results: dict[str, Checks] = {}
 
