@@ -14,8 +14,11 @@
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
 #include "core/util/error.h"
+#include "core/util/file_lock.h"
+#include "experiments/cli/cli.h"
 #include "experiments/cli/run_metadata.h"
 #include "experiments/runner/experiment_config.h"
+#include "experiments/runner/run_sequence.h"
 #include "experiments/runner/run_store.h"
 #include "experiments/runner/runner.h"
 #include "reference/scene_hash.h"
@@ -250,6 +253,144 @@ TEST(CpuRunner, DryRunPrintsTheParameterColumnsOfTheResultTables) {
         ++rows;
     }
     EXPECT_EQ(rows, 4);
+    fs::remove_all(dir);
+}
+
+/** baseConfig() on the built-in box and the spot-lit box: 2 references, 4 runs. */
+fs::path twoSceneConfig(const fs::path& dir) {
+    nlohmann::json j = baseConfig();
+    j["scenes"] = {"builtin", std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot"};
+    const fs::path config = dir / "tiny.json";
+    std::ofstream(config) << j.dump(2);
+    return config;
+}
+
+TEST(CpuRunner, ListReferencesNamesEachSceneOnce) {
+    const fs::path dir = tempDir("listrefs");
+    const std::vector<std::string> refs = listReferences(twoSceneConfig(dir).string());
+    ASSERT_EQ(refs.size(), 2u);
+    EXPECT_EQ(refs[0], "builtin");
+    EXPECT_EQ(refs[1], "cornell_box#spot");
+
+    // An animated scene: its static reference, then one per measured frame
+    nlohmann::json j = baseConfig();
+    j["scenes"] = {std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot_orbit"};
+    j["reference"]["frames"] = 4;
+    std::ofstream(dir / "anim.json") << j.dump(2);
+    const std::vector<std::string> anim = listReferences((dir / "anim.json").string());
+    const std::vector<int> frames = measuredFrames(9, 4);
+    ASSERT_EQ(anim.size(), 1 + frames.size());
+    EXPECT_EQ(anim[0], "cornell_box#spot_orbit");
+    for (size_t i = 0; i < frames.size(); ++i)
+        EXPECT_EQ(anim[1 + i], "cornell_box#spot_orbit@" + std::to_string(frames[i]));
+    fs::remove_all(dir);
+}
+
+TEST(CpuRunStore, ARunIsClaimedByOneProcessAndOnlyDeadTemporariesAreRemoved) {
+    const fs::path dir = tempDir("claims");
+    RunStore store(dir / "exp");
+    std::optional<FileLock> claim = store.tryClaim("k1");
+    ASSERT_TRUE(claim);
+    EXPECT_FALSE(store.tryClaim("k1"));  // held (flock conflicts between separate opens)
+    EXPECT_TRUE(store.tryClaim("k2"));
+    // A dead process's folder of k1 goes when k1 is begun; k2's and k10's stay
+    for (const char* name : {".tmp-k1-deadhost-1", ".tmp-k2-deadhost-1", ".tmp-k10-deadhost-1"})
+        fs::create_directories(dir / "exp" / "runs" / name);
+    const fs::path tmp = store.beginRun("k1");
+    EXPECT_TRUE(fs::is_directory(tmp));
+    EXPECT_NE(tmp.filename().string().find(processTag()), std::string::npos);
+    EXPECT_FALSE(fs::exists(dir / "exp" / "runs" / ".tmp-k1-deadhost-1"));
+    EXPECT_TRUE(fs::exists(dir / "exp" / "runs" / ".tmp-k2-deadhost-1"));
+    EXPECT_TRUE(fs::exists(dir / "exp" / "runs" / ".tmp-k10-deadhost-1"));
+    claim.reset();
+    EXPECT_TRUE(store.tryClaim("k1"));
+    fs::remove_all(dir);
+}
+
+TEST(CpuRunStore, AFinishedRunWithoutARowGetsItsRowBack) {
+    const fs::path dir = tempDir("rows");
+    RunStore store(dir / "exp");
+    nlohmann::ordered_json result = {{"key", "abc"},
+                                     {"index", 0},
+                                     {"status", "ok"},
+                                     {"scene", {{"label", "builtin"}}},
+                                     {"technique", {{"id", "direct"}}}};
+    const fs::path tmp = store.beginRun("abc");
+    std::ofstream(tmp / "result.json") << result.dump(2);
+    store.commitRun(tmp, "abc");  // killed here: committed, no row
+    EXPECT_EQ(store.addMissingRows(), 1u);
+    EXPECT_EQ(store.addMissingRows(), 0u);  // not twice
+    std::ifstream in(dir / "exp" / "results.jsonl");
+    std::string line;
+    int rows = 0;
+    while (std::getline(in, line))
+        rows += nlohmann::json::parse(line)["key"] == "abc" ? 1 : 0;
+    EXPECT_EQ(rows, 1);
+    EXPECT_TRUE(fs::exists(dir / "exp" / "results.csv"));
+    fs::remove_all(dir);
+}
+
+TEST(CpuSlurm, DryRunPrintsThreeScriptsWithArraysDevicesAndDependencies) {
+    const fs::path dir = tempDir("slurm");
+    cli::SlurmOptions o;
+    o.configPath = twoSceneConfig(dir).string();
+    o.shards = 3;
+    o.gres = "gpu:1";
+    o.partition = "gpu";
+    o.time = "00:30:00";
+    o.sbatchArgs = {"--account=lab"};
+    o.outRoot = (dir / "results").string();
+    o.referenceCacheDir = (dir / "cache").string();
+    o.dryRun = true;
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runSlurm(o), 0);
+    const std::string out = testing::internal::GetCapturedStdout();
+    auto has = [&](const std::string& s) { return out.find(s) != std::string::npos; };
+    EXPECT_TRUE(has("4 runs in 3 tasks; 2 distinct references in 2 tasks")) << out;
+    EXPECT_TRUE(has("--references-only --shard \"${SLURM_ARRAY_TASK_ID}/2\"")) << out;
+    EXPECT_TRUE(has("--shard \"${SLURM_ARRAY_TASK_ID}/3\"")) << out;
+    EXPECT_TRUE(has("#SBATCH --array=0-1")) << out;
+    EXPECT_TRUE(has("#SBATCH --array=0-2")) << out;
+    EXPECT_TRUE(has("#SBATCH --partition=gpu")) << out;
+    EXPECT_TRUE(has("#SBATCH --time=00:30:00")) << out;
+    EXPECT_TRUE(has("#SBATCH --account=lab")) << out;
+    EXPECT_TRUE(has("GILAB_DEVICE=\"${CUDA_VISIBLE_DEVICES%%,*}\"")) << out;
+    EXPECT_TRUE(has(" report '" + (dir / "results" / "tiny").string() + "'")) << out;
+    EXPECT_TRUE(has("--reference-cache '" + (dir / "cache").string() + "'")) << out;
+    // --gres only on the run tasks; the reference and report jobs open no Vulkan device
+    size_t gres = 0;
+    for (size_t at = out.find("#SBATCH --gres=gpu:1"); at != std::string::npos;
+         at = out.find("#SBATCH --gres=gpu:1", at + 1))
+        ++gres;
+    EXPECT_EQ(gres, 1u);
+    EXPECT_FALSE(fs::exists(dir / "results"));  // a dry run writes nothing
+
+    o.gres.clear();  // no GPUs: lavapipe
+    testing::internal::CaptureStdout();
+    cli::runSlurm(o);
+    EXPECT_NE(testing::internal::GetCapturedStdout().find("GILAB_DEVICE:-llvmpipe"),
+              std::string::npos);
+    fs::remove_all(dir);
+}
+
+TEST(CpuSlurm, WithoutSbatchTheErrorSaysWhatToDo) {
+    const fs::path dir = tempDir("nosbatch");
+    cli::SlurmOptions o;
+    o.configPath = twoSceneConfig(dir).string();
+    o.outRoot = (dir / "results").string();
+    o.referenceCacheDir = (dir / "cache").string();
+    const std::string path = std::getenv("PATH") ? std::getenv("PATH") : "";
+    ::setenv("PATH", (dir / "empty").c_str(), 1);
+    std::string message;
+    testing::internal::CaptureStdout();
+    try {
+        cli::runSlurm(o);
+    } catch (const Error& e) {
+        message = e.what();
+    }
+    testing::internal::GetCapturedStdout();
+    ::setenv("PATH", path.c_str(), 1);
+    EXPECT_NE(message.find("sbatch not found"), std::string::npos) << message;
     fs::remove_all(dir);
 }
 

@@ -307,7 +307,8 @@ def _mixed_references_note(runs: list[Run], page: Page, scene: str) -> str:
             f'({listing}). A bounce-matched error measures how well a technique renders the '
             'light paths it claims: one that leaves out bounces is not penalised for the missing '
             'light, so the matched rows only rank runs compared with the same reference'
-            + ('; the top row and every ranking use the full reference.' if full else '.')
+            + ('; the full-reference panels (at the top) and every ranking use the full '
+               'reference.' if full else '.')
             + '</p>')
 
 

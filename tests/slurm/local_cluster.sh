@@ -385,6 +385,10 @@ do_start() {
 [[ $# -eq 2 ]] || usage
 cmd=$1
 [[ -n $2 ]] || usage
+# slurm.conf cannot quote paths: reject such DIRs before creating anything.
+bad_chars='*[[:space:],=\(\)]*'
+# shellcheck disable=SC2053
+[[ $2 != $bad_chars ]] || die "DIR must not contain spaces, commas, '=' or parentheses: $2"
 
 case $cmd in
   start)
@@ -408,8 +412,9 @@ case $cmd in
 esac
 
 DIR=$(cd -- "$2" && pwd -P) || die "cannot enter directory $2"
-# slurm.conf cannot quote paths; unix socket paths are limited to 108 bytes.
-[[ $DIR != *[[:space:],=\(\)]* ]] || die "DIR must not contain spaces, commas, '=' or parentheses: $DIR"
+# shellcheck disable=SC2053
+[[ $DIR != $bad_chars ]] || die "DIR must not contain spaces, commas, '=' or parentheses: $DIR"
+# Unix socket paths (munge.sock, slurmd's spool sockets) are limited to 108 bytes.
 ((${#DIR} <= 70)) || die "DIR path is too long for unix sockets (max 70 chars): $DIR"
 
 if [[ $cmd == start ]]; then
