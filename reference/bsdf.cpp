@@ -132,6 +132,16 @@ float Bsdf::pdf(const glm::vec3& wo, const glm::vec3& wi) const {
 
 bool Bsdf::sample(const glm::vec3& wo, float uLobe, glm::vec2 u, BsdfSample& out) const {
     const Frame frame = Frame::fromZ(m_n);
+    if (!m_glossy) {
+        // Lambertian: what the general path below computes when pSpec = 0 (the cosine lobe,
+        // pdf() = cos / pi, eval() = albedo / pi), without its calls: bit-identical, cheaper
+        out.wi = glm::normalize(frame.toWorld(sampleCosineHemisphere(u)));
+        const float cosI = glm::dot(m_n, out.wi);
+        out.pdf = cosI > 0.0f ? cosI * kInvPi : 0.0f;
+        if (!(out.pdf > 0.0f)) return false;
+        out.f = m_albedo * kInvPi;
+        return true;
+    }
     const float pSpec = specularProbability(wo);
     if (uLobe < pSpec) {
         const glm::vec3 woLocal = frame.toLocal(wo);

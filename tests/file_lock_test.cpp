@@ -113,7 +113,7 @@ TEST(CpuFileLock, AnUnusableLockFileIsAnErrorNamingIt) {
 
 TEST(CpuFileLock, ProcessTagNamesHostAndPid) {
     const std::string tag = processTag();
-    const std::string pid = "-" + std::to_string(::getpid());
+    const std::string pid = std::string(1, '-').append(std::to_string(::getpid()));
     ASSERT_GT(tag.size(), pid.size());
     EXPECT_EQ(tag.substr(tag.size() - pid.size()), pid);
     EXPECT_EQ(tag.find('/'), std::string::npos);
