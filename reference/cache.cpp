@@ -301,6 +301,19 @@ size_t ReferenceCache::removeStaleTemporaries(std::chrono::seconds maxAge) const
     return removed;
 }
 
+size_t ReferenceCache::removeTemporariesOf(const std::string& key) const {
+    std::error_code ec;
+    if (!fs::is_directory(m_dir, ec)) return 0;
+    size_t removed = 0;
+    for (const fs::directory_entry& e : fs::directory_iterator(m_dir, ec)) {
+        const std::string name = e.path().filename().string();
+        if (name.rfind(".tmp-" + key + "-", 0) != 0 && name.rfind(".old-" + key + "-", 0) != 0)
+            continue;
+        if (fs::remove_all(e.path(), ec) > 0 && !ec) ++removed;
+    }
+    return removed;
+}
+
 nlohmann::ordered_json stopCriteriaJson(const StopCriteria& stop) {
     return {{"max_samples", stop.maxSamples},
             {"target_rel_error", stop.targetRelError},
@@ -428,6 +441,7 @@ ReferenceResult obtainReference(const Scene& scene, const ReferenceSettings& set
             r.reason = StopReason::Cancelled;
             return r;
         }
+        cache->removeTemporariesOf(r.key);  // only a dead process can have left any
     }
 
     // 1. A stored entry: reuse it, or continue from it

@@ -71,6 +71,9 @@ public:
 
     /** Removes `.tmp-*` and `.old-*` folders older than `maxAge`; returns how many. */
     size_t removeStaleTemporaries(std::chrono::seconds maxAge) const;
+    /** Removes every `.tmp-<key>-*` and `.old-<key>-*` folder, whatever its age: only for the
+     *  holder of the key's lock, when any such folder was left by a dead process. */
+    size_t removeTemporariesOf(const std::string& key) const;
 
 private:
     std::filesystem::path m_dir;

@@ -337,6 +337,19 @@ TEST(CpuObtainReference, ConcurrentRequestsRenderOnceAndShareTheEntry) {
     EXPECT_TRUE(std::filesystem::exists(cache.lockPath(results[0].key)));
 }
 
+TEST(CpuObtainReference, TheLockHolderRemovesADeadProcesssTemporariesOfItsKeyOnly) {
+    TempDir tmp;
+    const ref::ReferenceCache cache(tmp.path());
+    const std::string key = ref::referenceKey(tinyScene(), tinySettings());
+    const fs::path dead = tmp.path() / (".tmp-" + key + "-node7-4242-0");
+    const fs::path otherKey = tmp.path() / (".tmp-" + std::string(32, 'c') + "-node7-4242-0");
+    fs::create_directories(dead);
+    fs::create_directories(otherKey);
+    ref::obtainReference(tinyScene(), tinySettings(), samplesStop(4), &cache);
+    EXPECT_FALSE(fs::exists(dead));     // recent, but its key's lock was free: its writer is dead
+    EXPECT_TRUE(fs::exists(otherKey));  // another key: maybe a live writer
+}
+
 TEST(CpuObtainReference, WaitingForAnotherRendererCanBeCancelled) {
     TempDir tmp;
     const ref::ReferenceCache cache(tmp.path());

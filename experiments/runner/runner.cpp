@@ -4,6 +4,7 @@
 #include <charconv>
 #include <cstdio>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -201,6 +202,18 @@ std::string hostName() {
 }
 
 /**
+ * Writes `path` through a temporary file beside it (same extension, so the image writers pick
+ * the format) and one rename, so processes sharing the results folder never see a half-written
+ * file, even when two write the same one.
+ */
+void writeAtomically(const fs::path& path, const std::function<void(const std::string&)>& write) {
+    const fs::path tmp =
+        path.parent_path() / (".tmp-" + processTag() + "-" + path.filename().string());
+    write(tmp.string());
+    fs::rename(tmp, path);
+}
+
+/**
  * references/<label>/: the matched reference <matched>.{exr,png}, the full reference
  * full.{exr,png}, and the indirect light the run's `indirect` layer is compared with,
  * indirect_<bounces>.png (e.g. indirect_bounce1.png; indirect_full.png = all indirect light).
@@ -215,7 +228,7 @@ nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry
         const std::string id = safeLabel + "/" + file;
         if (c.writtenReferencePreviews[id]) return;
         fs::create_directories(dir);
-        write((dir / file).string());
+        writeAtomically(dir / file, write);
         c.writtenReferencePreviews[id] = true;
     };
     auto exr = [&](const std::string& file, const Image& mean, const Image& stdError) {
@@ -260,7 +273,9 @@ void writeReferenceFramePreview(Context& c, const SceneEntry& entry, int frame,
     if (c.writtenReferencePreviews[id]) return;
     const fs::path dir = c.store.dir() / "references" / safeLabel / "frames";
     fs::create_directories(dir);
-    writePngTonemapped((dir / framePreviewName(frame)).string(), set.match(kAllBounces).full, tm);
+    writeAtomically(dir / framePreviewName(frame), [&](const std::string& path) {
+        writePngTonemapped(path, set.match(kAllBounces).full, tm);
+    });
     c.writtenReferencePreviews[id] = true;
 }
 
