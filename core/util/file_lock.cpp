@@ -79,12 +79,17 @@ FileLock::~FileLock() {
     if (m_fd >= 0) ::close(m_fd);  // closing the descriptor releases the flock
 }
 
-std::string processTag() {
+std::string hostName() {
     char host[256] = {};
-    if (::gethostname(host, sizeof host - 1) != 0 || !host[0]) std::strcpy(host, "host");
+    return ::gethostname(host, sizeof host - 1) == 0 && host[0] ? std::string(host) : "unknown";
+}
+
+std::string processTag() {
     std::string tag;
-    for (const char* c = host; *c && *c != '.'; ++c)
-        tag += (std::isalnum(static_cast<unsigned char>(*c)) || *c == '-') ? *c : '_';
+    for (char c : hostName()) {
+        if (c == '.') break;  // the short name
+        tag += (std::isalnum(static_cast<unsigned char>(c)) || c == '-') ? c : '_';
+    }
     return tag + "-" + std::to_string(::getpid());
 }
 

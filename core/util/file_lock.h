@@ -43,6 +43,10 @@ private:
     int m_fd = -1;
 };
 
+/** This machine's host name (gethostname), "unknown" if it has none: the node in provenance,
+ *  in a run's result.json and in processTag(). */
+std::string hostName();
+
 /** "<host>-<pid>": names a process uniquely across the nodes sharing a folder (temporary
  *  files and folders; pids alone repeat from node to node). */
 std::string processTag();

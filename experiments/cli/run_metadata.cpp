@@ -10,6 +10,7 @@
 #include <thread>
 
 #include "core/util/build_info.h"
+#include "core/util/file_lock.h"
 #include "core/util/stats.h"
 #include "core/vk/context.h"
 
@@ -26,11 +27,6 @@ std::string cpuModel() {
         }
     }
     return "unknown";
-}
-
-std::string hostName() {
-    char buf[256] = {};
-    return gethostname(buf, sizeof buf - 1) == 0 ? std::string(buf) : "unknown";
 }
 
 nlohmann::ordered_json vec3Json(const glm::vec3& v) {

@@ -329,8 +329,10 @@ void RunStore::writeCsv() const {
             if (seen.insert(k).second) header.push_back(k);
     }
     std::string out;
-    for (size_t i = 0; i < header.size(); ++i)
-        out += (i ? "," : "") + csvEscape(header[i]);
+    for (size_t i = 0; i < header.size(); ++i) {
+        if (i) out += ',';
+        out += csvEscape(header[i]);
+    }
     out += "\n";
     for (const auto& cells : rows) {
         std::unordered_map<std::string, const std::string*> byKey;

@@ -8,8 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
-
-#include <unistd.h>
+#include <set>
 
 #include "core/image/image_io.h"
 #include "core/passes/shared_passes.h"
@@ -178,27 +177,25 @@ struct ReferenceTask {
     int frame;  // -1: the static scene
 };
 
-/** The distinct references of `runs`: each scene entry's, then its animation frames'. */
+/** The distinct references of `runs` (by cache key): each scene entry's, then its animation
+ *  frames' (frame 0 of an animation is usually the static scene's key, listed once). */
 std::vector<ReferenceTask> referenceTasks(const ExperimentConfig& config,
                                           const std::vector<RunSpec>& runs, SceneCache& scenes) {
     std::vector<ReferenceTask> tasks;
-    std::vector<std::string> seen;
+    std::set<std::string> labels, keys;
+    auto add = [&](const SceneEntry* entry, int frame, const Scene& scene) {
+        if (keys.insert(ref::referenceKey(scene, config.reference.settings)).second)
+            tasks.push_back({entry, frame});
+    };
     for (const RunSpec& r : runs) {
-        if (std::find(seen.begin(), seen.end(), r.scene->label) != seen.end()) continue;
-        seen.push_back(r.scene->label);
-        tasks.push_back({r.scene, -1});
+        if (!labels.insert(r.scene->label).second) continue;
         const Scene& scene = scenes.get(*r.scene);
+        add(r.scene, -1, scene);
         if (scene.animation.animated())
             for (int f : measuredFrames(scene.animation.frameCount, config.reference.frameStep))
-                tasks.push_back({r.scene, f});
+                add(r.scene, f, sceneAtFrame(scene, f));
     }
     return tasks;
-}
-
-std::string hostName() {
-    char host[256] = {};
-    if (::gethostname(host, sizeof host - 1) != 0) return "";
-    return host;
 }
 
 /**
@@ -515,10 +512,6 @@ void printDryRun(const std::vector<const RunSpec*>& runs, const std::vector<std:
     }
 }
 
-}  // namespace
-
-namespace {
-
 /** --references-only: the shard's share of the config's distinct references, each obtained
  *  under the cache's lock (rendered once, whoever asks). */
 RunnerSummary renderReferences(const ExperimentConfig& config, const std::vector<RunSpec>& runs,
@@ -687,9 +680,8 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
             summary.cancelled = true;
             return summary;
         }
-        // Finished by the other process: counted as done elsewhere; else (it died) run it here
-        const bool finishedThere = store.isFinished(keys[i]);
-        if (finishedThere) {
+        // Finished by the other process, or (it died) run here
+        if (store.isFinished(keys[i])) {
             ++summary.doneElsewhere;
             continue;
         }
