@@ -259,7 +259,11 @@ void ReferenceCache::store(const std::string& key, const Accumulator& acc,
         std::vector<ImageLayer> layers = meanLayers(acc);
         for (ImageLayer& l : stdErrorLayers(acc))
             layers.push_back(std::move(l));
-        writeExrLayers((tmp / "reference.exr").string(), layers);
+        writeExrLayers(
+            (tmp / "reference.exr").string(), layers,
+            {{kPixelFilterAttribute, sidecar.contains("settings")
+                                         ? sidecar["settings"].value("pixel_filter", std::string())
+                                         : std::string()}});
         syncPath(tmp / "reference.exr", false);
         writeTextSynced(tmp / "reference.json", sidecar.dump(2) + "\n");
         syncPath(tmp, true);

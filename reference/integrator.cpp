@@ -47,6 +47,24 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const MeshTriangle& tri, const
     return sp;
 }
 
+/**
+ * How far a hit point moves back along the ray that found it before its rays leave (world
+ * units; at most half the ray's length). The point carries a rounding error of a few ulps of its
+ * triangle's coordinates in every direction: at a concave edge it can fall a hair behind the
+ * neighbouring face, which then blocks or swallows every ray leaving it, and the normal offset
+ * moves it along its own face's normal only. The ray arrived through free space, so stepping
+ * back along it clears every face; 1024 ulps of the triangle's largest coordinate cover the
+ * error for rays down to 1/256 of grazing (docs/reference.md, "Ray offsets").
+ */
+float spawnBackOff(const MeshTriangle& tri) {
+    auto maxAbs = [](const glm::vec3& v) {
+        return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
+    };
+    const float m =
+        std::max(maxAbs(tri.p0), std::max(maxAbs(tri.p0 + tri.e1), maxAbs(tri.p0 + tri.e2)));
+    return m * 0x1p-13f;
+}
+
 bool isBlack(const glm::vec3& v) {
     return v.x == 0.0f && v.y == 0.0f && v.z == 0.0f;
 }
@@ -75,10 +93,11 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
     const SurfacePoint sp = makeSurfacePoint(m_scene, tri, hit, wo);
     const Material& mat = *sp.material;
     const glm::vec3 beta = p.beta;
+    const TextureFootprint* fp = k == 1 && p.hasFootprint ? &p.footprint : nullptr;
 
     // Emission towards the previous vertex: the camera (emission layer) or vertex k - 1
     if (mat.isEmissive() && (sp.frontFace || mat.doubleSided)) {
-        const glm::vec3 le = lookupEmission(mat, m_textures, sp.uv);
+        const glm::vec3 le = lookupEmission(mat, m_textures, sp.uv, fp);
         if (k == 1) {
             out.L[int(Layer::Emission)] += le;
         } else if (useBsdfHits) {
@@ -95,10 +114,11 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
     }
     if (k > lastVertex) return false;
 
-    const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv);
-    const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv);
+    const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv, fp);
+    const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv, fp);
     const Bsdf bsdf(sp.n, glm::vec3(baseColor), metalRough.x, metalRough.y);
-    const glm::vec3 origin = offsetRayOrigin(sp.p, sp.ng, m_offsetScale);
+    const float backOff = std::min(spawnBackOff(tri), 0.5f * hit.t);
+    const glm::vec3 origin = offsetRayOrigin(sp.p + wo * backOff, sp.ng, m_offsetScale);
     const int layer = int(layerForVertex(k));
 
     // Next-event estimation: every punctual light (delta lights, lights.glsl formulas)

@@ -26,11 +26,11 @@
 #include "reference/embree_scene.h"
 #include "reference/path_tracer.h"
 #include "reference/sampling.h"
+#include "reference/texture_lookup.h"
 
 namespace gilab::ref {
 
 class LightSampler;
-class TextureLookup;
 
 /** Radiance of one camera path per layer (index = Layer); Full = the sum of the others. */
 struct PathRadiance {
@@ -54,6 +54,10 @@ struct PathState {
     uint32_t slot = 0;         // index of this path's PathRadiance
     RayHit hit;
     bool found = false;
+    // The camera hit's texture footprint (pixel-centre rays): vertex 1 then looks its textures up
+    // at the rasteriser's mip level, as the G-buffer does (docs/reference.md, "Pixel filter").
+    bool hasFootprint = false;
+    TextureFootprint footprint;
 };
 
 /** A shadow ray of one vertex and the light it adds to `slot`'s layer if unoccluded. */
@@ -81,7 +85,8 @@ public:
     /**
      * Traces every path from its camera ray (rayO, rayD set, vertex = 1) to its end; out[slot]
      * receives the path's radiance per layer. `cameraHitsKnown`: the paths' hit/found already
-     * hold the camera ray's closest hit (pixel-centre rays, traced once per pixel). `packets`:
+     * hold the camera ray's closest hit (the centre filter traces them first, for the texture
+     * footprint). `packets`:
      * rtcIntersect16 + an rtcOccluded1M stream (default) or one rtcIntersect1/rtcOccluded1
      * per ray (benchmarks; the same estimator). `sink` receives every ray traced, or nullptr.
      */

@@ -22,11 +22,52 @@
 namespace gilab::ref {
 namespace {
 
+/** Half-width of the centre filter, in pixels: 2^-10. A pixel centre lying exactly on an edge
+ *  then sees both faces in proportion instead of one picked by rounding. */
+constexpr float kCenterJitter = 0x1p-10f;
+
 /** The camera ray's position inside the pixel. The sampler's dimensions are consumed either
  *  way, so both filters see the same random numbers along the rest of the path. */
 glm::vec2 pixelOffset(Sampler& sampler, PixelFilter filter) {
     const glm::vec2 u = sampler.get2D();
-    return filter == PixelFilter::Center ? glm::vec2(0.5f) : u;
+    return filter == PixelFilter::Center ? 0.5f + (2.0f * u - 1.0f) * kCenterJitter : u;
+}
+
+/** uv at image point (px, py) on the plane of `tri` (the rasteriser interpolates attributes over
+ *  the triangle's plane, also for helper pixels outside it); false if the ray misses the plane. */
+bool planeUv(const PrimaryRays& rays, const MeshTriangle& tri, float px, float py, glm::vec2& uv) {
+    const Ray ray = rays(px, py);
+    const float denom = glm::dot(tri.n, ray.direction);
+    if (!(std::abs(denom) > 1e-12f)) return false;
+    const glm::vec3 q = ray.origin + ray.direction * (glm::dot(tri.n, tri.p0 - ray.origin) / denom);
+    const glm::vec3 v = q - tri.p0;
+    const float d00 = glm::dot(tri.e1, tri.e1), d01 = glm::dot(tri.e1, tri.e2);
+    const float d11 = glm::dot(tri.e2, tri.e2);
+    const float d20 = glm::dot(v, tri.e1), d21 = glm::dot(v, tri.e2);
+    const float det = d00 * d11 - d01 * d01;
+    if (!(det > 0.0f)) return false;
+    uv = tri.uvAt((d11 * d20 - d01 * d21) / det, (d00 * d21 - d01 * d20) / det);
+    return std::isfinite(uv.x) && std::isfinite(uv.y);
+}
+
+/**
+ * The rasteriser's texture footprint at pixel (x, y) on `tri`: its uv derivatives per 2 x 2 quad
+ * (the pixel's quad's top-left pixel to its right and lower neighbours, as lavapipe's dFdx /
+ * dFdy), from the uvs of the triangle's plane at those pixel centres. A plane seen edge-on gives
+ * the coarsest level.
+ */
+TextureFootprint rasterFootprint(const PrimaryRays& rays, const MeshTriangle& tri, int x, int y) {
+    const float qx = float(x & ~1) + 0.5f, qy = float(y & ~1) + 0.5f;
+    glm::vec2 uv00, uv10, uv01;
+    TextureFootprint fp;
+    if (planeUv(rays, tri, qx, qy, uv00) && planeUv(rays, tri, qx + 1.0f, qy, uv10) &&
+        planeUv(rays, tri, qx, qy + 1.0f, uv01)) {
+        fp.dx = uv10 - uv00;
+        fp.dy = uv01 - uv00;
+    } else {
+        fp.dx = fp.dy = glm::vec2(1e6f);
+    }
+    return fp;
 }
 
 constexpr int kTileSize = 8;
@@ -102,7 +143,7 @@ struct PathTracer::Impl {
     Impl(const Scene& s, const ReferenceSettings& st)
         : scene((validate(s, st), s)),
           settings(st),
-          textures(scene.textures),
+          textures(scene.textures, st.pixelFilter == PixelFilter::Center),
           mesh(scene, textures),
           lights(scene, textures, mesh),
           integrator(scene, settings, mesh, lights, textures) {}
@@ -177,40 +218,43 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
     std::vector<PathState>& paths = ws.paths;
     std::vector<int>& pathPixel = ws.pathPixel;
 
-    // Pixel-centre rays are the same for every sample: trace each once per call, same packets
+    // Centre filter: the camera rays are traced here, a 4 x 4 block per packet, so each hit
+    // gets the rasteriser's texture footprint before it is shaded
     const bool center = settings.pixelFilter == PixelFilter::Center;
-    RayHit cameraHit[kTileSize * kTileSize];
-    if (center) {
-        for (int by = y0; by < y1; by += kPacketSize)
-            for (int bx = x0; bx < x1; bx += kPacketSize) {
-                glm::vec3 o[16], d[16];
-                int tilePixel[16];
-                int n = 0;
-                for (int y = by; y < std::min(by + kPacketSize, y1); ++y)
-                    for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x, ++n) {
-                        const Ray ray = cameraRay(float(x) + 0.5f, float(y) + 0.5f);
-                        o[n] = ray.origin;
-                        d[n] = ray.direction;
-                        tilePixel[n] = (y - y0) * tw + (x - x0);
-                    }
-                RayHit hits[16];
-                if (packets) {
-                    mesh.intersect16(n, o, d, std::numeric_limits<float>::infinity(), hits);
-                } else {
-                    for (int i = 0; i < n; ++i)
-                        if (!mesh.intersect(o[i], d[i], 0.0f,
-                                            std::numeric_limits<float>::infinity(), hits[i]))
-                            hits[i].prim = ~0u;
-                }
-                for (int i = 0; i < n; ++i) {
-                    cameraHit[tilePixel[i]] = hits[i];
-                    if (sink)
-                        sink->push_back(
-                            {o[i], d[i], 0.0f, std::numeric_limits<float>::infinity(), false});
-                }
-                counters.cameraRays += uint64_t(n);
+    auto traceCameraRays = [&]() {
+        for (size_t first = 0; first < paths.size(); first += 16) {
+            const int n = int(std::min<size_t>(16, paths.size() - first));
+            glm::vec3 o[16], d[16];
+            for (int i = 0; i < n; ++i) {
+                o[i] = paths[first + size_t(i)].rayO;
+                d[i] = paths[first + size_t(i)].rayD;
             }
-    }
+            RayHit hits[16];
+            if (packets) {
+                mesh.intersect16(n, o, d, std::numeric_limits<float>::infinity(), hits);
+            } else {
+                for (int i = 0; i < n; ++i)
+                    if (!mesh.intersect(o[i], d[i], 0.0f, std::numeric_limits<float>::infinity(),
+                                        hits[i]))
+                        hits[i].prim = ~0u;
+            }
+            for (int i = 0; i < n; ++i) {
+                PathState& path = paths[first + size_t(i)];
+                path.hit = hits[i];
+                path.found = hits[i].prim != ~0u;
+                path.hasFootprint = path.found;
+                if (path.found) {
+                    const int tilePixel = pathPixel[first + size_t(i)];
+                    path.footprint = rasterFootprint(cameraRay, mesh.triangle(hits[i].prim),
+                                                     x0 + tilePixel % tw, y0 + tilePixel / tw);
+                }
+                if (sink)
+                    sink->push_back(
+                        {o[i], d[i], 0.0f, std::numeric_limits<float>::infinity(), false});
+            }
+            counters.cameraRays += uint64_t(n);
+        }
+    };
     for (uint64_t s0 = first; s0 < first + count; s0 += kWaveSamples) {
         const uint64_t s1 = std::min<uint64_t>(first + count, s0 + kWaveSamples);
         paths.clear();
@@ -228,13 +272,9 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
                             path.rayO = ray.origin;
                             path.rayD = ray.direction;
                             path.slot = uint32_t(paths.size() - 1);
-                            const int tilePixel = (y - y0) * tw + (x - x0);
-                            pathPixel.push_back(tilePixel);
-                            if (center) {
-                                path.hit = cameraHit[tilePixel];
-                                path.found = path.hit.prim != ~0u;
-                            }
+                            pathPixel.push_back((y - y0) * tw + (x - x0));
                         }
+        if (center) traceCameraRays();
         ws.radiance.resize(paths.size());
         integrator.tracePaths(paths, ws.radiance.data(), center, packets, counters, sink, ws.wave);
         for (size_t i = 0; i < paths.size(); ++i)

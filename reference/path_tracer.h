@@ -42,15 +42,20 @@ enum class Estimator { Mis, NeeOnly, BsdfOnly };
 const char* estimatorName(Estimator e);  // "mis", "nee", "bsdf"
 
 /**
- * Where a pixel's camera rays go. Box (default): uniformly over the pixel's square, the
- * antialiased image. Center: every ray through the pixel centre, like the rasteriser's single
- * sample per pixel, so comparisons with techniques carry no antialiasing differences at edges.
+ * Where a pixel's camera rays go. Center (the default of the CLI and of experiment configs):
+ * the rasteriser's footprint: every ray through the pixel centre (within 2^-10 px, so a centre
+ * on an edge sees both faces), and the camera hit's textures filtered at the rasteriser's mip
+ * level, so comparisons with techniques carry no antialiasing or texture-filtering differences.
+ * Box: uniformly over the pixel's square, the antialiased image, textures at mip 0.
  */
 enum class PixelFilter { Box, Center };
 const char* pixelFilterName(PixelFilter f);  // "box", "center"
 
-/** Bumped whenever a change alters the images; part of every reference cache key. */
-inline constexpr int kRendererVersion = 3;  // 3: roulette by default, wavefront (issue 16)
+/** Bumped whenever a change alters the images; part of every reference cache key.
+ *  3: roulette by default, wavefront (issue 16); 4: hit points step back along the arriving ray
+ *  (concave edges), the centre filter is 2^-10 px wide and looks the camera hit's textures up
+ *  at the rasteriser's mip level (issue 27). */
+inline constexpr int kRendererVersion = 4;
 
 struct ReferenceSettings {
     /** Indirect bounces computed: 0 = emission + direct only; paths have at most
@@ -62,7 +67,7 @@ struct ReferenceSettings {
     float rouletteThreshold = 0.05f;
     Estimator estimator = Estimator::Mis;
     uint64_t seed = 1;
-    PixelFilter pixelFilter = PixelFilter::Box;
+    PixelFilter pixelFilter = PixelFilter::Center;
     /** Independent uniforms (default) or Owen-scrambled Sobol (docs/reference.md, "Samplers"). */
     SamplerKind sampler = SamplerKind::Independent;
     /** Samples added per pass over the image; the stop criteria are checked between passes. */

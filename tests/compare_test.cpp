@@ -484,3 +484,31 @@ TEST(CpuCompare, PrintsTableOrJson) {
     const nlohmann::json j = nlohmann::json::parse(testing::internal::GetCapturedStdout());
     EXPECT_EQ(j["metrics"]["rel_mse"].get<double>(), compareImages(o).metrics.relMse);
 }
+
+// Issue 27: every gilab EXR records its pixel footprint; compare warns when they differ.
+TEST(CpuCompare, WarnsWhenThePixelFootprintsDiffer) {
+    TempDir dir;
+    const Image image = pattern(16, 16);
+    auto write = [&](const std::string& name, const std::string& filter) {
+        const std::string path = dir.file(name);
+        ExrAttributes attributes;
+        if (!filter.empty()) attributes.push_back({kPixelFilterAttribute, filter});
+        writeExrLayers(path, {{"", image}}, attributes);
+        EXPECT_EQ(readImageStringAttribute(path, kPixelFilterAttribute), filter);
+        return path;
+    };
+    const std::string center = write("center.exr", "center");
+    const std::string box = write("box.exr", "box");
+    const std::string unknown = write("unknown.exr", "");
+
+    const CompareResult differ = compareImages(options(center, box));
+    ASSERT_EQ(differ.warnings.size(), 1u);
+    EXPECT_NE(differ.warnings[0].find("test: center, reference: box"), std::string::npos)
+        << differ.warnings[0];
+    EXPECT_EQ(differ.json["reference"]["pixel_filter"], "box");
+    EXPECT_TRUE(compareImages(options(center, center)).warnings.empty());
+    // Not recorded: no check, and null in the JSON
+    const CompareResult none = compareImages(options(center, unknown));
+    EXPECT_TRUE(none.warnings.empty());
+    EXPECT_TRUE(none.json["reference"]["pixel_filter"].is_null());
+}

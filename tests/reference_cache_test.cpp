@@ -125,7 +125,7 @@ TEST(CpuReferenceKey, EveryImageInputChangesTheKey) {
         {"roulette", [](Scene&, auto& r) { r.rouletteStartBounce = 3; }},
         {"estimator", [](Scene&, auto& r) { r.estimator = ref::Estimator::NeeOnly; }},
         {"seed", [](Scene&, auto& r) { r.seed += 1; }},
-        {"pixel filter", [](Scene&, auto& r) { r.pixelFilter = ref::PixelFilter::Center; }},
+        {"pixel filter", [](Scene&, auto& r) { r.pixelFilter = ref::PixelFilter::Box; }},
     };
     std::set<std::string> keys = {ref::referenceKey(tinyScene(), tinySettings())};
     for (const auto& [what, edit] : edits) {
@@ -474,6 +474,13 @@ TEST(CpuReferenceCommand, WritesOutputsAndReusesTheCache) {
     EXPECT_EQ(j["provenance"]["command_line"], "gilab reference --spp 8");
     EXPECT_EQ(j["scene"]["resolution"][0], 12);
     EXPECT_EQ(j["settings"]["max_bounces"], 2);
+    // The rasteriser's footprint by default, recorded in the EXRs' headers (issue 27)
+    EXPECT_EQ(j["settings"]["pixel_filter"], "center");
+    EXPECT_EQ(readImageStringAttribute((out / "reference.exr").string(), kPixelFilterAttribute),
+              "center");
+    EXPECT_EQ(readImageStringAttribute((tmp.path() / "cache" / key / "reference.exr").string(),
+                                       kPixelFilterAttribute),
+              "center");
     EXPECT_EQ(j["key_description"]["key"], key);
     EXPECT_TRUE(j["renderer"]["tracer"].is_string());
     EXPECT_TRUE(j["rel_error"].is_number());

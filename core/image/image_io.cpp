@@ -109,17 +109,29 @@ void writeImageAtomic(const std::string& path, const char* formatName, const OII
 }  // namespace detail
 
 void writeExrWithMainImage(const std::string& path, const std::vector<ImageLayer>& layers,
-                           const std::string& mainLayer) {
+                           const std::string& mainLayer, const ExrAttributes& attributes) {
     const Image* main = findLayer(layers, mainLayer);
     if (!main) throw Error(path + ": no layer '" + mainLayer + "' to write as the main image");
     std::vector<ImageLayer> withMain;
     withMain.reserve(layers.size() + 1);
     withMain.push_back({"", *main});
     withMain.insert(withMain.end(), layers.begin(), layers.end());
-    writeExrLayers(path, withMain);
+    writeExrLayers(path, withMain, attributes);
 }
 
-void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& layers) {
+std::string readImageStringAttribute(const std::string& path, const std::string& name) {
+    auto in = OIIO::ImageInput::open(path);
+    if (!in) {
+        (void)OIIO::geterror();  // clear the message: "no attribute" is the answer
+        return "";
+    }
+    const std::string value = in->spec().get_string_attribute(name);
+    in->close();
+    return value;
+}
+
+void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& layers,
+                    const ExrAttributes& attributes) {
     validateLayers(path, layers);
     const int width = layers[0].image.width();
     const int height = layers[0].image.height();
@@ -156,6 +168,8 @@ void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& laye
     spec.z_channel = -1;
     spec.attribute("compression", "zip");
     spec.attribute(kLayerOrderAttribute, joinStrings(order, ","));
+    for (const auto& [name, value] : attributes)
+        spec.attribute(name, value);
     detail::writeImageAtomic(path, "openexr", spec, buffer.data());
 }
 

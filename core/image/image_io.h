@@ -10,13 +10,25 @@
 
 namespace gilab {
 
+/** String header attributes of an EXR ("gilab:..." name, value). */
+using ExrAttributes = std::vector<std::pair<std::string, std::string>>;
+
+/**
+ * Header attribute naming the pixel footprint an image samples (docs/conventions.md "Camera and
+ * images"): "center" (one sample at the pixel centre: every technique, and the reference's centre
+ * filter) or "box" (the whole pixel square: the reference's box filter). gilab compare warns
+ * when two images' footprints differ.
+ */
+inline constexpr const char* kPixelFilterAttribute = "gilab:pixelFilter";
+
 /**
  * Writes one EXR holding every layer, channels named "<layer>.R/G/B" ("<layer>.Z" for 1-channel
  * layers, "<layer>.A" for a 4th), float32. Atomic: written to a temporary file, then renamed.
  * Layers have 1 to 4 channels (Z; R,G; R,G,B; R,G,B,A), one size and unique names; a layer
  * named "" is written unprefixed ("R", "G", "B"). ZIP compression (lossless).
  */
-void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& layers);
+void writeExrLayers(const std::string& path, const std::vector<ImageLayer>& layers,
+                    const ExrAttributes& attributes = {});
 /**
  * Reads a file written by writeExrLayers (or any EXR with "<layer>.<chan>" channel names).
  * Channels are grouped by the text before their last '.'; channels with no '.' (a plain
@@ -32,7 +44,9 @@ std::vector<ImageLayer> readExrLayers(const std::string& path);
  * (docs/conventions.md "Output files"). Throws if there is no such layer.
  */
 void writeExrWithMainImage(const std::string& path, const std::vector<ImageLayer>& layers,
-                           const std::string& mainLayer);
+                           const std::string& mainLayer, const ExrAttributes& attributes = {});
+/** A string header attribute of an image file, or "" when it has none (or is not readable). */
+std::string readImageStringAttribute(const std::string& path, const std::string& name);
 /** The layer named `name`, or nullptr. */
 const Image* findLayer(const std::vector<ImageLayer>& layers, const std::string& name);
 

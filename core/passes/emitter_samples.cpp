@@ -54,6 +54,21 @@ glm::vec3 lookupTexture(const Texture& tex, glm::vec2 uv) {
     return c;
 }
 
+/** Mean of the texture's texels, decoded to linear. */
+glm::vec3 textureMean(const Texture& tex) {
+    if (tex.width <= 0 || tex.height <= 0) return glm::vec3(1.0f);
+    glm::dvec3 sum(0.0);
+    const size_t n = size_t(tex.width) * size_t(tex.height);
+    for (size_t i = 0; i < n; ++i) {
+        glm::vec3 c(tex.rgba[4 * i] / 255.0f, tex.rgba[4 * i + 1] / 255.0f,
+                    tex.rgba[4 * i + 2] / 255.0f);
+        if (tex.colorSpace == ColorSpace::Srgb)
+            c = glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
+        sum += glm::dvec3(c);
+    }
+    return glm::vec3(sum / double(n));
+}
+
 glm::vec3 emittedRadiance(const Scene& scene, const Material& m, glm::vec2 uv) {
     glm::vec3 le = m.emissiveFactor;
     if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size()) {
@@ -99,6 +114,25 @@ std::vector<EmitterTriangle> collectEmitters(const Scene& scene) {
 
 size_t countEmitterTriangles(const Scene& scene) {
     return collectEmitters(scene).size();
+}
+
+std::vector<EmitterPolygon> buildEmitterPolygons(const Scene& scene) {
+    std::vector<EmitterPolygon> out;
+    std::vector<glm::vec3> textureMeans(scene.textures.size(), glm::vec3(-1.0f));
+    for (const EmitterTriangle& e : collectEmitters(scene)) {
+        EmitterPolygon p;
+        p.p0 = e.p0, p.p1 = e.p1, p.p2 = e.p2;
+        p.twoSided = e.material->doubleSided;
+        p.radiance = e.material->emissiveFactor;
+        const int t = e.material->emissiveTexture;
+        if (t >= 0 && size_t(t) < scene.textures.size()) {
+            glm::vec3& mean = textureMeans[size_t(t)];
+            if (mean.x < 0.0f) mean = textureMean(scene.textures[size_t(t)]);
+            p.radiance *= mean;
+        }
+        out.push_back(p);
+    }
+    return out;
 }
 
 std::vector<EmitterSample> buildEmitterSamples(const Scene& scene, uint32_t count) {

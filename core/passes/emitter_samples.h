@@ -36,8 +36,22 @@ struct EmitterSample {
     uint32_t triangle = 0;
 };
 
+/**
+ * An emissive triangle for the direct pass's exact unoccluded irradiance (Lambert's polygon
+ * formula, docs/shared_passes.md "Area lights"): its vertices (counter-clockwise), its radiance
+ * (emissive factor x the mean of its emissive texture) and whether both faces emit.
+ */
+struct EmitterPolygon {
+    glm::vec3 p0{0.0f}, p1{0.0f}, p2{0.0f};
+    glm::vec3 radiance{0.0f};
+    bool twoSided = false;
+};
+
 /** Emissive triangles with a non-zero area and radiance. */
 size_t countEmitterTriangles(const Scene& scene);
+
+/** Every emissive triangle with a non-zero area and radiance, in triangle order. */
+std::vector<EmitterPolygon> buildEmitterPolygons(const Scene& scene);
 
 /** `count` samples (none when count == 0 or the scene has no emitter). */
 std::vector<EmitterSample> buildEmitterSamples(const Scene& scene, uint32_t count);

@@ -29,14 +29,19 @@ struct PassLight {
     glm::vec4 positionType{0.0f};  // xyz position (not directional), w = PassLightType
     glm::vec4 direction{0.0f};     // xyz travel direction (spot, directional) or emitter normal;
                                    // w 1 = two-sided emitter sample
-    glm::vec4 intensity{0.0f};     // rgb W/sr (point, spot), W/m^2 (directional), Le*A (sample)
+    glm::vec4 intensity{0.0f};     // rgb W/sr (point, spot), W/m^2 (directional), Le*A (sample);
+                                   // w: sample area / pi (disk radius squared)
     glm::vec4 cone{0.0f};          // x cos(inner), y cos(outer) (spot)
     glm::vec4 shadow{0.0f};        // x ShadowKind, y layer / cube index, z texel size factor,
                                    // w 1 = orthographic (texel = z) else perspective (z * dist)
-    glm::vec4 bias{0.0f};          // x constant, y slope, z normal offset (texels), w PCF radius
+    glm::vec4 bias{0.0f};          // volume receivers (voxel centres): x constant, y slope,
+                                   // z normal offset (texels), w PCF radius
+    glm::vec4 surfaceBias{0.0f};   // surface receivers (the direct pass): the same four
+    glm::vec4 cascades{0.0f};      // x first cascade entry, y count (directional lights),
+                                   // z 1 = receiver-plane test for surface receivers
     glm::vec4 origin{0.0f};        // orthographic: a point on the entry plane
     glm::mat4 viewProj{1.0f};      // 2D maps: world -> Vulkan clip space
 };
-static_assert(sizeof(PassLight) == 176);
+static_assert(sizeof(PassLight) == 208);
 
 }  // namespace gilab

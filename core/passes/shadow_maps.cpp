@@ -5,10 +5,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include <glm/gtc/constants.hpp>
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "core/gpu/gpu_scene.h"
 #include "core/passes/distance_map.h"
+#include "core/passes/shadow_cascades.h"
 #include "core/util/error.h"
 #include "core/vk/context.h"
 #include "core/vk/rendering.h"
@@ -36,15 +38,13 @@ glm::mat4 spotViewProj(const glm::vec3& eye, const glm::vec3& dir, float fov, fl
     return p * glm::lookAtRH(eye, eye + dir, upFor(dir));
 }
 
-/** Orthographic over the square [-r, r]^2 with y down; depth = 1 - distance / (2r). */
-glm::mat4 orthoViewProj(const glm::vec3& origin, const glm::vec3& dir, float r) {
-    glm::mat4 p(0.0f);
-    p[0][0] = 1.0f / r;
-    p[1][1] = -1.0f / r;
-    p[2][2] = 1.0f / (2.0f * r);  // z_view = -distance
-    p[3][2] = 1.0f;
-    p[3][3] = 1.0f;
-    return p * glm::lookAtRH(origin, origin + dir, upFor(dir));
+/** The whole-scene orthographic frame of a directional light: the bounding sphere (x 1.02). */
+OrthoLightFrame orthoFrame(const glm::vec3& center, float radius, const glm::vec3& dir) {
+    OrthoLightFrame f;
+    f.radius = 1.02f * radius + 1e-4f;
+    f.direction = dir;
+    f.origin = center - dir * f.radius;
+    return f;
 }
 
 vk::Image makeDistanceImage(vk::Context& ctx, vk::ImageKind kind, uint32_t size, uint32_t layers,
@@ -63,12 +63,16 @@ vk::Image makeDistanceImage(vk::Context& ctx, vk::ImageKind kind, uint32_t size,
 }  // namespace
 
 ShadowMaps::ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettings& settings,
-                       uint32_t areaLightSamples)
-    : m_ctx(ctx), m_scene(scene), m_settings(settings) {
+                       uint32_t areaLightSamples, float aspect)
+    : m_ctx(ctx), m_scene(scene), m_settings(settings), m_aspect(aspect) {
     if (settings.resolution == 0 || settings.areaResolution == 0) {
         throw Error("ShadowSettings: resolution and areaResolution must be non-zero");
     }
     if (settings.pcfRadius < 0) throw Error("ShadowSettings: pcfRadius must be >= 0");
+    if (!(settings.cascadeSplit >= 0.0f && settings.cascadeSplit <= 1.0f))
+        throw Error("ShadowSettings: cascadeSplit must be in [0, 1]");
+    if (!(aspect > 0.0f) || !std::isfinite(aspect))
+        throw Error("ShadowMaps: the frame's aspect ratio must be positive");
     buildLightTable(scene, areaLightSamples);
     createImages();
 
@@ -97,7 +101,7 @@ void ShadowMaps::addCubeJobs(const PassLight& light, uint32_t lightIndex, Shadow
                              uint32_t cube, const Job::Push& base, float nearZ,
                              std::vector<Job>& jobs) const {
     for (int face = 0; face < 6; ++face) {
-        Job job{kind, cube * 6 + uint32_t(face), lightIndex, base};
+        Job job{kind, cube * 6 + uint32_t(face), lightIndex, false, base};
         const CubeFace& f = kCubeFaces[face];
         job.push.viewProj =
             pinholeViewProj(glm::vec3(light.positionType), f.m, f.s, f.t, 1.0f, nearZ);
@@ -107,7 +111,7 @@ void ShadowMaps::addCubeJobs(const PassLight& light, uint32_t lightIndex, Shadow
 }
 
 PassLight ShadowMaps::sceneLightEntry(const Light& l, uint32_t index, ShadowKind kind,
-                                      uint32_t slot, std::vector<Job>& jobs) const {
+                                      uint32_t slot, std::vector<Job>& jobs) {
     const Frame frame = sceneFrame();
     const float res = float(m_settings.resolution);
     PassLight light;
@@ -115,8 +119,10 @@ PassLight ShadowMaps::sceneLightEntry(const Light& l, uint32_t index, ShadowKind
     light.direction = glm::vec4(glm::normalize(l.direction), 0.0f);
     light.intensity = glm::vec4(l.intensity, 0.0f);
     light.cone = glm::vec4(std::cos(l.innerConeRad), std::cos(l.outerConeRad), 0.0f, 0.0f);
-    light.bias = glm::vec4(m_settings.constantBias, m_settings.slopeBias, m_settings.normalOffset,
-                           float(m_settings.pcfRadius));
+    light.bias = kVolumeShadowBias;
+    light.surfaceBias = glm::vec4(m_settings.constantBias, m_settings.slopeBias,
+                                  m_settings.normalOffset, float(m_settings.pcfRadius));
+    light.cascades = glm::vec4(0.0f, 0.0f, m_settings.receiverPlane ? 1.0f : 0.0f, 0.0f);
     const glm::vec3 dir(light.direction);
     light.positionType.w = float(l.type == LightType::Point  ? kPassLightPoint
                                  : l.type == LightType::Spot ? kPassLightSpot
@@ -129,31 +135,58 @@ PassLight ShadowMaps::sceneLightEntry(const Light& l, uint32_t index, ShadowKind
         light.viewProj = spotViewProj(l.position, dir, fov, frame.nearZ);
         light.shadow =
             glm::vec4(float(kShadowMap2D), float(slot), 2.0f * std::tan(0.5f * fov) / res, 0.0f);
-        Job job{kShadowMap2D, slot, index, {}};
+        Job job{kShadowMap2D, slot, index, false, {}};
         job.push.viewProj = light.viewProj;
         job.push.origin = glm::vec4(l.position, 0.0f);
         jobs.push_back(job);
     } else if (kind == kShadowMap2D) {  // directional: orthographic over the bounding sphere
-        const float r = 1.02f * frame.radius + 1e-4f;
-        const glm::vec3 origin = frame.center - dir * r;
-        light.origin = glm::vec4(origin, 1.0f);
-        light.viewProj = orthoViewProj(origin, dir, r);
-        light.shadow = glm::vec4(float(kShadowMap2D), float(slot), 2.0f * r / res, 1.0f);
-        Job job{kShadowMap2D, slot, index, {}};
+        const OrthoLightFrame of = orthoFrame(frame.center, frame.radius, dir);
+        light.origin = glm::vec4(of.origin, 1.0f);
+        light.viewProj = orthoSceneViewProj(of);
+        light.shadow = glm::vec4(float(kShadowMap2D), float(slot), 2.0f * of.radius / res, 1.0f);
+        Job job{kShadowMap2D, slot, index, false, {}};
         job.push.viewProj = light.viewProj;
-        job.push.origin = glm::vec4(origin, 1.0f);
+        job.push.origin = light.origin;
         job.push.direction = glm::vec4(dir, 0.0f);
         jobs.push_back(job);
     }
     return light;
 }
 
+void ShadowMaps::fitCascades(const PassLight& light, uint32_t index, uint32_t firstEntry,
+                             uint32_t firstLayer, std::vector<Job>& jobs) {
+    const Scene& scene = m_scene.scene();
+    OrthoLightFrame of;
+    of.origin = glm::vec3(light.origin);
+    of.direction = glm::vec3(light.direction);
+    of.radius = 0.5f * light.shadow.z * float(m_settings.resolution);
+    CascadeSettings cs;
+    cs.count = m_settings.cascades;
+    cs.split = m_settings.cascadeSplit;
+    cs.resolution = m_settings.resolution;
+    cs.marginTexels = uint32_t(m_settings.pcfRadius) + 2;
+    const std::vector<ShadowCascade> fitted =
+        fitShadowCascades(scene.camera, m_aspect, scene.caps.bounds, of, cs);
+    for (uint32_t k = 0; k < uint32_t(fitted.size()); ++k) {
+        PassLight c = light;  // same light: its intensity, direction, settings and distance origin
+        c.cascades = glm::vec4(0.0f, 0.0f, light.cascades.z, 0.0f);
+        c.viewProj = fitted[k].viewProj;
+        c.shadow = glm::vec4(float(kShadowMap2D), float(firstLayer + k), fitted[k].texel, 1.0f);
+        m_cascades[firstEntry + k] = c;
+        Job job{kShadowMap2D, firstLayer + k, index, true, {}};
+        job.push.viewProj = c.viewProj;
+        job.push.origin = c.origin;
+        job.push.direction = glm::vec4(glm::vec3(c.direction), 0.0f);
+        jobs.push_back(job);
+    }
+}
+
 void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLightSamples) {
     const Scene& scene = gpuScene.scene();
     const bool shadows = m_settings.enabled;
     const Frame frame = sceneFrame();
-    const glm::vec4 bias(m_settings.constantBias, m_settings.slopeBias, m_settings.normalOffset,
-                         float(m_settings.pcfRadius));
+    m_samples = buildEmitterSamples(scene, areaLightSamples);
+    const uint32_t tableSize = uint32_t(scene.lights.size() + m_samples.size());
 
     for (uint32_t i = 0; i < uint32_t(scene.lights.size()); ++i) {
         const Light& l = scene.lights[i];
@@ -168,19 +201,30 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
             kind = kShadowMap2D;
             slot = m_layers2D++;
         }
-        m_lights.push_back(sceneLightEntry(l, i, kind, slot, m_jobs));
+        PassLight light = sceneLightEntry(l, i, kind, slot, m_jobs);
+        if (kind == kShadowMap2D && l.type == LightType::Directional && m_settings.cascades > 0) {
+            const uint32_t first = uint32_t(m_cascades.size());
+            m_cascades.resize(first + m_settings.cascades);
+            light.cascades.x = float(tableSize + first);
+            light.cascades.y = float(m_settings.cascades);
+            fitCascades(light, i, first, m_layers2D, m_jobs);
+            m_layers2D += m_settings.cascades;
+        }
+        m_lights.push_back(light);
     }
     m_sceneLightCount = uint32_t(m_lights.size());
 
     // Emitter samples: cosine-lobe point lights with their own cubes
-    m_samples = buildEmitterSamples(scene, areaLightSamples);
     const float areaRes = float(m_settings.areaResolution);
     for (const EmitterSample& s : m_samples) {
         PassLight light;
         light.positionType = glm::vec4(s.position, float(kPassLightEmitterSample));
         light.direction = glm::vec4(s.normal, s.twoSided ? 1.0f : 0.0f);
-        light.intensity = glm::vec4(s.intensity, 0.0f);
-        light.bias = bias;
+        light.intensity = glm::vec4(s.intensity, s.area / glm::pi<float>());
+        light.bias = kVolumeShadowBias;
+        light.surfaceBias = glm::vec4(m_settings.constantBias, m_settings.slopeBias,
+                                      m_settings.normalOffset, float(m_settings.pcfRadius));
+        light.cascades = glm::vec4(0.0f, 0.0f, m_settings.receiverPlane ? 1.0f : 0.0f, 0.0f);
         if (shadows) {
             Job::Push skip;
             skip.skipPlane = glm::vec4(s.normal, glm::dot(s.normal, s.position));
@@ -193,6 +237,23 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
         }
         m_lights.push_back(light);
     }
+
+    // The emissive triangles behind the samples, for the exact unoccluded irradiance
+    std::vector<glm::vec4> polygons;
+    if (!m_samples.empty()) {
+        for (const EmitterPolygon& p : buildEmitterPolygons(scene)) {
+            polygons.push_back(glm::vec4(p.p0, p.twoSided ? 1.0f : 0.0f));
+            polygons.push_back(glm::vec4(p.p1, 0.0f));
+            polygons.push_back(glm::vec4(p.p2, 0.0f));
+            polygons.push_back(glm::vec4(p.radiance, 0.0f));
+        }
+    }
+    m_polygonCount = uint32_t(polygons.size() / 4);
+    if (polygons.empty()) polygons.resize(4, glm::vec4(0.0f));
+    m_polygonBuffer =
+        vk::Buffer(m_ctx, polygons.size() * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                   vk::MemoryUsage::DeviceLocal, "shared/area_lights.polygons");
+    m_polygonBuffer.uploadVector(polygons);
 
     // Skip lines for what the scene lacks
     const bool hasEmitters = countEmitterTriangles(scene) > 0;
@@ -218,15 +279,21 @@ void ShadowMaps::buildLightTable(const vk::GpuScene& gpuScene, uint32_t areaLigh
     }
 
     // Upload the table and tell the scene's light buffer where each light's map is
-    m_lightBuffer = vk::Buffer(m_ctx, std::max<size_t>(m_lights.size(), 1) * sizeof(PassLight),
-                               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::DeviceLocal,
-                               "shared/shadow.lights");
-    m_lightBuffer.uploadVector(m_lights);
+    m_lightBuffer = vk::Buffer(
+        m_ctx, std::max<size_t>(m_lights.size() + m_cascades.size(), 1) * sizeof(PassLight),
+        VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::DeviceLocal, "shared/shadow.lights");
+    uploadTable();
     std::vector<int> shadowIndex(gpuScene.lightCount(), -1);
     for (size_t i = 0; i < shadowIndex.size() && i < m_sceneLightCount; ++i) {
         if (m_lights[i].shadow.x != float(kShadowNone)) shadowIndex[i] = int(i);
     }
     if (!shadowIndex.empty()) m_scene.setLightShadowIndices(shadowIndex);
+}
+
+void ShadowMaps::uploadTable() {
+    std::vector<PassLight> table = m_lights;
+    table.insert(table.end(), m_cascades.begin(), m_cascades.end());
+    if (!table.empty()) m_lightBuffer.uploadVector(table);
 }
 
 void ShadowMaps::createImages() {
@@ -269,24 +336,51 @@ void ShadowMaps::createImages() {
 
 void ShadowMaps::updateSceneLights(const std::vector<uint32_t>& changed) {
     const Scene& scene = m_scene.scene();
+    const uint32_t tableSize = lightCount();
     for (uint32_t i : changed) {
         if (i >= m_sceneLightCount || i >= scene.lights.size())
             throw Error("ShadowMaps::updateSceneLights: light " + std::to_string(i) + " of " +
                         std::to_string(m_sceneLightCount));
-        const PassLight& old = m_lights[i];
+        const PassLight old = m_lights[i];
         std::vector<Job> jobs;
-        m_lights[i] = sceneLightEntry(scene.lights[i], i, ShadowKind(uint32_t(old.shadow.x)),
-                                      uint32_t(old.shadow.y), jobs);
-        size_t k = 0;  // same light type, same slot: its jobs are replaced in place
+        PassLight light = sceneLightEntry(scene.lights[i], i, ShadowKind(uint32_t(old.shadow.x)),
+                                          uint32_t(old.shadow.y), jobs);
+        light.cascades = old.cascades;
+        if (old.cascades.y > 0.0f) {
+            const uint32_t first = uint32_t(old.cascades.x) - tableSize;
+            fitCascades(light, i, first, uint32_t(m_cascades[first].shadow.y), jobs);
+        }
+        m_lights[i] = light;
+        size_t k = 0;  // same light type, same slots: its jobs are replaced in place, in order
         for (Job& job : m_jobs)
             if (job.light == i && k < jobs.size()) job = jobs[k++];
     }
-    if (!changed.empty()) m_lightBuffer.uploadVector(m_lights);
+    if (!changed.empty()) uploadTable();
 }
 
-void ShadowMaps::record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights) {
+std::vector<uint32_t> ShadowMaps::updateCamera() {
+    std::vector<uint32_t> refitted;
+    const uint32_t tableSize = lightCount();
+    for (uint32_t i = 0; i < m_sceneLightCount; ++i) {
+        const PassLight& light = m_lights[i];
+        if (light.cascades.y <= 0.0f) continue;
+        const uint32_t first = uint32_t(light.cascades.x) - tableSize;
+        std::vector<Job> jobs;
+        fitCascades(light, i, first, uint32_t(m_cascades[first].shadow.y), jobs);
+        size_t k = 0;
+        for (Job& job : m_jobs)
+            if (job.light == i && job.cascade && k < jobs.size()) job = jobs[k++];
+        refitted.push_back(i);
+    }
+    if (!refitted.empty()) uploadTable();
+    return refitted;
+}
+
+void ShadowMaps::record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights,
+                        bool cascadesOnly) {
     if (m_jobs.empty() || m_scene.triangleCount() == 0) return;
     auto wanted = [&](const Job& job) {
+        if (cascadesOnly && !job.cascade) return false;
         return !onlyLights ||
                std::find(onlyLights->begin(), onlyLights->end(), job.light) != onlyLights->end();
     };

@@ -7,7 +7,9 @@
  * fragments, reversed-Z with an infinite far plane, shared by all renders):
  *   spot (outer cone <= 85 deg)  2D perspective, fov = 2 * outer + 5 deg (<= 170 deg)
  *   directional                  2D orthographic fitted to the scene's bounding sphere; stores the
- *                                distance along the light direction from the sphere's entry plane
+ *                                distance along the light direction from the sphere's entry plane;
+ *                                plus `cascades` 2D maps fitted to the camera's view
+ *                                (shadow_cascades.h), used by surface receivers
  *   point, spot > 85 deg         cube (6 faces, one render each; Vulkan cube face axes)
  *   emitter sample               cube at areaResolution; surfaces in the emitter's own plane are
  *                                not rendered (they cannot occlude the emitter's hemisphere)
@@ -43,19 +45,30 @@ class GpuScene;
 }  // namespace vk
 
 /**
- * Bias terms are in shadow-map texels at the receiver (texel = the map's texel footprint at the
+ * Lookup settings of surface receivers (the direct pass: points of rasterised triangles). Bias
+ * terms are in shadow-map texels at the receiver (texel = the map's texel footprint at the
  * receiver's distance), so they hold for any scene scale and resolution. See
- * docs/shared_passes.md for how the defaults were tuned.
+ * docs/shared_passes.md for how the defaults were measured against the path tracer.
  */
 struct ShadowSettings {
-    uint32_t resolution = 1024;     // 2D maps and point-light cubes, texels per side
+    uint32_t resolution = 1024;     // 2D maps, cascades and point-light cubes, texels per side
     uint32_t areaResolution = 256;  // emitter-sample cubes, texels per side
-    int pcfRadius = 1;              // (2r+1)^2 taps; 0 = hard shadows
-    float constantBias = 1.0f;      // texels
-    float slopeBias = 1.0f;         // texels per unit tan(theta)
-    float normalOffset = 1.0f;      // texels, receiver moved along its normal
+    int pcfRadius = 0;              // (2r+1)^2 taps; 0 = hard shadows
+    float constantBias = 0.5f;      // texels
+    float slopeBias = 0.0f;         // texels per unit tan(theta)
+    float normalOffset = 0.0f;      // texels per (pcfRadius + 1), receiver moved along its normal
+    bool receiverPlane = true;      // compare each texel with the receiver's plane along its ray
+    uint32_t cascades = 4;          // view-fitted maps per directional light (0 = none)
+    float cascadeSplit = 0.5f;      // split scheme: 0 uniform, 1 logarithmic
     bool enabled = true;            // false: no maps at all, visibility = 1
 };
+
+/**
+ * Settings of volume receivers (voxel centres: shadowVisibility in shadow.glsl), which have no
+ * triangle plane: the offset-and-slope test with x constant 1, y slope 1 (texels), z normal
+ * offset 1 (texels per PCF radius + 1), w PCF radius 1.
+ */
+inline constexpr glm::vec4 kVolumeShadowBias{1.0f, 1.0f, 1.0f, 1.0f};
 
 class ShadowMaps {
 public:
@@ -64,9 +77,12 @@ public:
     /** Bindings used by shadow.glsl, starting at SHADOW_BINDING. */
     static constexpr uint32_t kBindingCount = 4;
 
-    /** Builds the light table (uploads it), the emitter samples and the images. */
+    /**
+     * Builds the light table (uploads it), the emitter samples and the images. The cascades are
+     * fitted to the GpuScene's scene camera at this aspect (width / height).
+     */
     ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettings& settings,
-               uint32_t areaLightSamples);
+               uint32_t areaLightSamples, float aspect);
     ShadowMaps(const ShadowMaps&) = delete;
     ShadowMaps& operator=(const ShadowMaps&) = delete;
 
@@ -74,19 +90,31 @@ public:
      * Renders every map (one draw of the scene per 2D map or cube face), or only the maps of
      * the pass lights in `onlyLights` (an animated scene re-renders the lights that moved).
      */
-    void record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights = nullptr);
+    void record(VkCommandBuffer cmd, const std::vector<uint32_t>* onlyLights = nullptr,
+                bool cascadesOnly = false);
     /**
      * Recomputes the table entries and map matrices of scene lights `changed` from the
      * GpuScene's scene (same count and types; each keeps its map slot) and re-uploads the
      * table. Their maps are stale until record(cmd, &changed).
      */
     void updateSceneLights(const std::vector<uint32_t>& changed);
+    /**
+     * Refits the cascades to the GpuScene's scene camera (it moved) and re-uploads the table.
+     * Returns the scene lights whose cascades are stale until record(cmd, &lights, true).
+     */
+    std::vector<uint32_t> updateCamera();
 
     const std::vector<PassLight>& lights() const { return m_lights; }
     uint32_t lightCount() const { return uint32_t(m_lights.size()); }
     const vk::Buffer& lightBuffer() const { return m_lightBuffer; }
     const std::vector<EmitterSample>& emitterSamples() const { return m_samples; }
+    /** The emissive triangles (4 vec4 each: p0 + w two-sided, p1, p2, radiance), built with the
+     *  emitter samples (a 1-entry placeholder when there are none). */
+    const vk::Buffer& emitterPolygonBuffer() const { return m_polygonBuffer; }
+    uint32_t emitterPolygonCount() const { return m_polygonCount; }
     const ShadowSettings& settings() const { return m_settings; }
+    /** The cascade entries (after lights() in the buffer), in light order. */
+    const std::vector<PassLight>& cascadeEntries() const { return m_cascades; }
     /** Number of scene lights (the first entries of lights()). */
     uint32_t sceneLightCount() const { return m_sceneLightCount; }
     /** Map renders (2D layers + cube faces) per record(). */
@@ -107,8 +135,9 @@ private:
     /** One render: a 2D layer or one cube face. The push block mirrors shadow_pc.glsl. */
     struct Job {
         ShadowKind kind = kShadowNone;
-        uint32_t layer = 0;  // layer of the target image (6 * cube + face for cubes)
-        uint32_t light = 0;  // index into lights()
+        uint32_t layer = 0;    // layer of the target image (6 * cube + face for cubes)
+        uint32_t light = 0;    // index into lights()
+        bool cascade = false;  // a view-fitted cascade of `light`
         struct Push {
             glm::mat4 viewProj{1.0f};
             glm::vec4 origin{0.0f};  // w 1 = orthographic
@@ -127,9 +156,14 @@ private:
     };
     Frame sceneFrame() const;
     /** The table entry of scene light `l` (index `index`) with its map in `slot` of `kind`
-     *  (kShadowNone: no map), appending its render jobs to `jobs`. */
+     *  (kShadowNone: no map), appending its render jobs to `jobs` and, for a directional light
+     *  with cascades, writing them to m_cascades from its `cascades.x` entry on. */
     PassLight sceneLightEntry(const Light& l, uint32_t index, ShadowKind kind, uint32_t slot,
-                              std::vector<Job>& jobs) const;
+                              std::vector<Job>& jobs);
+    /** Fits light `index`'s cascades (entries from `firstEntry`, layers from `firstLayer`). */
+    void fitCascades(const PassLight& light, uint32_t index, uint32_t firstEntry,
+                     uint32_t firstLayer, std::vector<Job>& jobs);
+    void uploadTable();
     void addCubeJobs(const PassLight& light, uint32_t lightIndex, ShadowKind kind, uint32_t cube,
                      const Job::Push& base, float nearZ, std::vector<Job>& jobs) const;
     void buildLightTable(const vk::GpuScene& scene, uint32_t areaLightSamples);
@@ -139,6 +173,8 @@ private:
     vk::GpuScene& m_scene;
     ShadowSettings m_settings;
     std::vector<PassLight> m_lights;
+    std::vector<PassLight> m_cascades;  // cascade entries, after m_lights in the buffer
+    float m_aspect = 1.0f;
     std::vector<EmitterSample> m_samples;
     std::vector<Job> m_jobs;
     std::vector<std::string> m_skipped;
@@ -148,6 +184,8 @@ private:
     uint32_t m_areaCubeCount = 0;
 
     vk::Buffer m_lightBuffer;
+    vk::Buffer m_polygonBuffer;
+    uint32_t m_polygonCount = 0;
     vk::Image m_maps2D;
     vk::Image m_cubes;
     vk::Image m_areaCubes;

@@ -8,7 +8,8 @@
  * recordShadows() renders them (the harness calls it during setup so their cost is reported once,
  * as setup time); record() renders them only while they are not valid yet (first frame without a
  * setup call) or after invalidateShadows(). An animated light (updateLights) gets its own map,
- * and only its map, re-rendered by recordShadowUpdates() in the next dynamic frame.
+ * and only its map, re-rendered by recordShadowUpdates() in the next dynamic frame; a camera
+ * move (updateCamera) re-renders only the directional lights' view-fitted cascades.
  */
 #include <cstdint>
 #include <memory>
@@ -33,6 +34,7 @@ class GpuTimer;
 struct SharedPassSettings {
     ShadowSettings shadow;
     uint32_t areaLightSamples = 16;  // K emitter samples standing in for emissive triangles
+    bool areaLightAnalytic = true;   // exact unoccluded irradiance, samples for visibility
 };
 
 class SharedPasses {
@@ -53,7 +55,13 @@ public:
      * theirs, are re-rendered by the next recordShadowUpdates().
      */
     void updateLights(const std::vector<uint32_t>& changed);
-    /** Re-renders the maps of the lights given to updateLights() (pass "shadow_maps.update"). */
+    /**
+     * The camera of the GpuScene's scene moved: the directional lights' cascades are refitted
+     * now and re-rendered by the next recordShadowUpdates().
+     */
+    void updateCamera();
+    /** Re-renders the maps of the lights given to updateLights() and the cascades refitted by
+     *  updateCamera() (pass "shadow_maps.update"). */
     void recordShadowUpdates(VkCommandBuffer cmd, vk::GpuTimer* timer = nullptr);
     bool shadowsValid() const { return m_shadowsValid; }
 
@@ -78,7 +86,8 @@ private:
     std::unique_ptr<ShadowMaps> m_shadows;
     std::unique_ptr<DirectLightPass> m_direct;
     bool m_shadowsValid = false;
-    std::vector<uint32_t> m_staleLights;  // scene lights whose maps await recordShadowUpdates
+    std::vector<uint32_t> m_staleLights;    // scene lights whose maps await recordShadowUpdates
+    std::vector<uint32_t> m_staleCascades;  // scene lights whose cascades await it
 };
 
 }  // namespace gilab

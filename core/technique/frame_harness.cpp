@@ -158,9 +158,12 @@ FrameTiming FrameHarness::renderFrame() {
         // technique's update (its own timed submissions), all inside this frame's time.
         t.dynamic = true;
         Stopwatch update;
-        if (!m_pending.lights.empty()) {
-            m_gpuScene->updateLights(m_pending.lights);
-            m_shared->updateLights(m_pending.lights);
+        if (!m_pending.lights.empty() || m_pending.camera) {
+            if (!m_pending.lights.empty()) {
+                m_gpuScene->updateLights(m_pending.lights);
+                m_shared->updateLights(m_pending.lights);
+            }
+            if (m_pending.camera) m_shared->updateCamera();
             m_ctx.submitAndWait([&](VkCommandBuffer cmd) {
                 if (timer) timer->reset(cmd);
                 m_shared->recordShadowUpdates(cmd, timer);

@@ -12,22 +12,39 @@ std::vector<ParamSpec> sharedPassParamSpecs() {
         boolParam("shadows", d.enabled, "Shadow maps on (off: every light is unoccluded)",
                   ParamStage::Rebuild),
         intParam("shadow_resolution", int(d.resolution), 16, 8192, "texels",
-                 "Side of each 2D shadow map and point-light cube face", ParamStage::Rebuild),
+                 "Side of each 2D shadow map, cascade and point-light cube face",
+                 ParamStage::Rebuild),
         intParam("area_shadow_resolution", int(d.areaResolution), 16, 4096, "texels",
                  "Side of each emitter-sample cube face", ParamStage::Rebuild),
         intParam("pcf_radius", d.pcfRadius, 0, 8, "texels",
                  "PCF kernel radius, (2r+1)^2 taps; 0 = hard shadows", ParamStage::Rebuild),
         floatParam("shadow_constant_bias", d.constantBias, 0.0, 64.0, "texels",
-                   "Constant depth bias", ParamStage::Rebuild),
+                   "Constant depth bias (direct pass)", ParamStage::Rebuild),
         floatParam("shadow_slope_bias", d.slopeBias, 0.0, 64.0, "texels",
-                   "Depth bias per unit tan(angle to the light)", ParamStage::Rebuild),
-        floatParam("shadow_normal_offset", d.normalOffset, 0.0, 64.0, "texels",
-                   "Receiver offset along its normal, in texels per (pcf_radius + 1)",
+                   "Depth bias per unit tan(angle to the light) (direct pass)",
                    ParamStage::Rebuild),
+        floatParam("shadow_normal_offset", d.normalOffset, 0.0, 64.0, "texels",
+                   "Receiver offset along its normal, in texels per (pcf_radius + 1) (direct "
+                   "pass)",
+                   ParamStage::Rebuild),
+        boolParam("shadow_receiver_plane", d.receiverPlane,
+                  "Compare each shadow-map texel with the receiver triangle's plane along the "
+                  "texel's ray (off: only the biases above)",
+                  ParamStage::Rebuild),
+        intParam("shadow_cascades", int(d.cascades), 0, 8, "",
+                 "View-fitted shadow maps per directional light (0 = the whole-scene map only)",
+                 ParamStage::Rebuild),
+        floatParam("shadow_cascade_split", d.cascadeSplit, 0.0, 1.0, "",
+                   "Cascade split scheme: 0 uniform in depth, 1 logarithmic", ParamStage::Rebuild),
         intParam("area_light_samples", int(s.areaLightSamples), 0, 4096, "",
                  "Virtual point lights standing in for emissive surfaces in the direct pass "
                  "(0 = emitters light nothing directly)",
                  ParamStage::Rebuild),
+        boolParam("area_light_analytic", s.areaLightAnalytic,
+                  "Direct pass: the emissive triangles' unoccluded irradiance is exact (Lambert's "
+                  "polygon formula) and the samples give its visible share (off: the samples' "
+                  "sum alone)",
+                  ParamStage::Rebuild),
     };
 }
 
@@ -49,7 +66,11 @@ SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
     s.shadow.constantBias = p.getFloat("shadow_constant_bias");
     s.shadow.slopeBias = p.getFloat("shadow_slope_bias");
     s.shadow.normalOffset = p.getFloat("shadow_normal_offset");
+    s.shadow.receiverPlane = p.getBool("shadow_receiver_plane");
+    s.shadow.cascades = uint32_t(p.getInt("shadow_cascades"));
+    s.shadow.cascadeSplit = p.getFloat("shadow_cascade_split");
     s.areaLightSamples = uint32_t(p.getInt("area_light_samples"));
+    s.areaLightAnalytic = p.getBool("area_light_analytic");
     const double res = double(s.shadow.areaResolution);
     const double bytes = double(s.areaLightSamples) * 6.0 * res * res * 8.0;
     if (s.shadow.enabled && bytes > kMaxAreaShadowBytes)

@@ -213,8 +213,8 @@ int runMain(int argc, char** argv) {
         ->capture_default_str();
     ref->add_option("--seed", reference.seed, "Random seed")->capture_default_str();
     ref->add_option("--pixel-filter", reference.pixelFilter,
-                    "box: rays over the whole pixel; center: through the pixel centre, like the "
-                    "rasteriser")
+                    "center: the rasteriser's footprint (rays through the pixel centre, camera-hit "
+                    "textures at its mip level); box: rays over the whole pixel (antialiased)")
         ->check(CLI::IsMember({"box", "center"}))
         ->capture_default_str();
     ref->add_option("--sampler", reference.sampler,
@@ -311,6 +311,36 @@ int runMain(int argc, char** argv) {
         ->capture_default_str();
     benchTechCmd->add_option("--device", benchTech.device, "Vulkan device name substring or index");
     benchTechCmd->add_flag("--quiet,-q", benchTech.quiet, "No progress lines");
+
+    BenchDirectOptions benchDirect;
+    benchDirect.commandLine = commandLine;
+    CLI::App* benchDirectCmd = bench->add_subcommand(
+        "direct",
+        "The shared direct light against the path tracer on every shipped scene: energy, light "
+        "leaked into shadowed pixels, HDR-FLIP, frame cost");
+    benchDirectCmd->add_option("--scene", benchDirect.scenes,
+                               "Scene (repeatable); default: every scenes/*.json and "
+                               "scenes/stress/*.json with each of its variants");
+    benchDirectCmd->add_option("--set", benchDirect.assignments,
+                               "shared.key=value for the shared passes (repeatable)");
+    benchDirectCmd->add_option("--resolution", benchDirect.resolution,
+                               "WxH; default: each scene's");
+    benchDirectCmd
+        ->add_option("--area-spp", benchDirect.areaSpp,
+                     "Reference samples per pixel where emitters light the scene (delta lights "
+                     "need one)")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 30))
+        ->capture_default_str();
+    benchDirectCmd->add_option("--frames", benchDirect.frames, "Timed frames")
+        ->check(CLI::Range(1, 100000))
+        ->capture_default_str();
+    benchDirectCmd->add_option("--cache", benchDirect.cacheDir, "Reference cache folder")
+        ->excludes(benchDirectCmd->add_flag("--no-cache", benchDirect.noCache,
+                                            "Neither read nor write the cache"));
+    benchDirectCmd->add_option("--device", benchDirect.device,
+                               "Vulkan device name substring or index");
+    benchDirectCmd->add_option("--out,-o", benchDirect.outDir, "Also write bench_direct.json here");
+    benchDirectCmd->add_flag("--quiet,-q", benchDirect.quiet, "No progress lines");
 
     exp::RunnerOptions run;
     run.commandLine = commandLine;
@@ -449,6 +479,7 @@ int runMain(int argc, char** argv) {
         }
         if (*ref) return runReference(reference);
         if (*benchRefCmd) return runBenchReference(benchRef);
+        if (*benchDirectCmd) return runBenchDirect(benchDirect);
         if (*benchTechCmd) {
             for (const std::string& t : benchTech.techniques)
                 checkTechniqueName(t);

@@ -82,6 +82,23 @@ struct BenchTechniqueOptions {
 };
 int runBenchTechnique(const BenchTechniqueOptions& options);
 
+/** `gilab bench direct`: the shared direct light against the path tracer on every shipped scene
+ *  (docs/shared_passes.md, "Accuracy"). */
+struct BenchDirectOptions {
+    std::vector<std::string> scenes;       // default: scenes/*.json, scenes/stress/*.json, variants
+    std::vector<std::string> assignments;  // shared.key=value (the direct pass's settings)
+    std::string resolution;                // "WxH", "" = each scene's
+    uint64_t areaSpp = 1024;               // reference samples where emitters light the scene
+    int frames = 5;                        // timed frames after one warm-up
+    std::string cacheDir;
+    bool noCache = false;
+    std::string device;
+    std::string outDir;  // "" = print only
+    bool quiet = false;
+    std::string commandLine;
+};
+int runBenchDirect(const BenchDirectOptions& options);
+
 /** Options of `gilab reference` (docs/reference_cache.md), also used by tests. */
 struct ReferenceOptions {
     std::string scenePath;  // "" = the built-in Cornell box
@@ -92,7 +109,7 @@ struct ReferenceOptions {
     int rouletteDepth = ref::ReferenceSettings{}.rouletteStartBounce;
     float rouletteThreshold = ref::ReferenceSettings{}.rouletteThreshold;
     std::string estimator = "mis";        // mis | nee | bsdf
-    std::string pixelFilter = "box";      // "box" | "center"
+    std::string pixelFilter = "center";   // "center" (the rasteriser's footprint) | "box"
     std::string sampler = "independent";  // "independent" | "sobol"
     uint64_t seed = 1;
     uint32_t batchSamples = 4;

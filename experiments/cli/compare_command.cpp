@@ -30,6 +30,7 @@ struct LoadedImage {
     std::string argument;
     ImageArgument source;
     Image image;
+    std::string pixelFilter;  // the file's kPixelFilterAttribute, "" = not recorded
 };
 
 bool isExrPath(const std::string& path) {
@@ -82,6 +83,7 @@ LoadedImage loadImage(const std::string& text, const char* role) {
     }
     if (isExrPath(arg.path)) {
         out.image = readExrLayer(arg);
+        out.pixelFilter = readImageStringAttribute(arg.path, kPixelFilterAttribute);
     } else if (arg.layer && !arg.layer->empty()) {
         throw Error(std::string(role) + " image " + quoted(text) + ": layers (':" + *arg.layer +
                     "') need an EXR file, and " + quoted(arg.path) + " is not one");
@@ -285,6 +287,7 @@ Json imageJson(const LoadedImage& in) {
             {"width", in.image.width()},
             {"height", in.image.height()},
             {"channels", in.image.channels()},
+            {"pixel_filter", in.pixelFilter.empty() ? Json(nullptr) : Json(in.pixelFilter)},
             {"nan_pixels", s.nanPixels},
             {"inf_pixels", s.infPixels},
             {"negative_pixels", s.negativePixels}};
@@ -511,6 +514,15 @@ CompareResult compareImages(const CompareOptions& options) {
 
     addInputNotes("test", test.image, r.notes);
     addInputNotes("reference", ref.image, r.notes);
+    if (!test.pixelFilter.empty() && !ref.pixelFilter.empty() &&
+        test.pixelFilter != ref.pixelFilter) {
+        r.warnings.push_back(
+            "the images sample different pixel footprints (test: " + test.pixelFilter +
+            ", reference: " + ref.pixelFilter +
+            "): edges and textures differ by that alone; render the reference with "
+            "--pixel-filter " +
+            test.pixelFilter + " (docs/conventions.md, \"Camera and images\")");
+    }
     if (mask && mask->count() == 0) r.notes.push_back("the mask selects no pixel");
     const bool hdrFlip = selected(r.selected, "hdr-flip");
     if (hdrFlip && !r.exposureFixed) {
@@ -547,6 +559,7 @@ CompareResult compareImages(const CompareOptions& options) {
     }
     r.json["metrics"] = metricsJson(r.metrics, r.selected);
     r.json["notes"] = r.notes;
+    r.json["warnings"] = r.warnings;
     if (!options.outDir.empty()) writeOutputs(options.outDir, c, r);
     return r;
 }
@@ -559,6 +572,8 @@ int runCompare(const CompareOptions& options) {
         std::fprintf(stderr, "gilab: error: %s\n", e.what());
         return kExitUsage;
     }
+    for (const std::string& w : r.warnings)
+        std::fprintf(stderr, "gilab: warning: %s\n", w.c_str());
     if (options.json) {
         std::printf("%s\n", r.json.dump(2).c_str());
     } else {

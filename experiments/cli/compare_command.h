@@ -49,8 +49,9 @@ struct CompareResult {
     bool exposureFixed = false;         // --flip-exposure given
     bool zeroMedianFallback = false;    // HDR-FLIP's automatic range used the fallback
     std::vector<std::string> notes;
-    std::vector<std::string> files;  // written under outDir
-    nlohmann::ordered_json json;     // the summary (compare.json)
+    std::vector<std::string> warnings;  // printed to stderr: e.g. the pixel footprints differ
+    std::vector<std::string> files;     // written under outDir
+    nlohmann::ordered_json json;        // the summary (compare.json)
 };
 /** Reads both images (and the mask), computes the selected metrics with gilab::metrics and,
  *  with outDir, writes the error maps and compare.json. Throws cli::UsageError (bad option

@@ -144,7 +144,9 @@ int renderReference(const ReferenceOptions& options, const Scene& scene,
         finite = finiteJson(layers, &nonFinite);
         for (ImageLayer& l : ref::stdErrorLayers(r.acc))
             layers.push_back(std::move(l));
-        writeExrWithMainImage(base + ".exr", layers, "full");
+        writeExrWithMainImage(
+            base + ".exr", layers, "full",
+            {{kPixelFilterAttribute, ref::pixelFilterName(settings.pixelFilter)}});
         ToneMap tm;
         tm.exposureEv = scene.settings.exposureEv;
         writePngTonemapped(base + ".png", layers.front().image, tm);

@@ -146,7 +146,7 @@ int runRender(const RenderOptions& options) {
         meta["stats"][name] = value;
     harness.reset();
 
-    writeExrWithMainImage(exrPath.string(), layers, "final");
+    writeExrWithMainImage(exrPath.string(), layers, "final", {{kPixelFilterAttribute, "center"}});
     ToneMap tm;
     tm.exposureEv = scene.settings.exposureEv;
     writePngTonemapped((outDir / "final.png").string(), layers.front().image, tm);

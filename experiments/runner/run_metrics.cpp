@@ -3,10 +3,16 @@
 #include <cmath>
 
 #include "core/util/error.h"
+#include "experiments/metrics/direct_accuracy.h"
 #include "experiments/metrics/metrics.h"
 
 namespace gilab::exp {
 namespace {
+
+/** A number, or null when it is not finite. */
+nlohmann::ordered_json jsonNumber(double v) {
+    return std::isfinite(v) ? nlohmann::ordered_json(v) : nlohmann::ordered_json(nullptr);
+}
 
 const Image& layerImage(const std::vector<ImageLayer>& layers, const std::string& name) {
     for (const ImageLayer& l : layers)
@@ -56,7 +62,7 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
     const Image& refIndirect =
         reference.indirect.empty() ? reference.fullIndirect : reference.indirect;
     const double energy = metrics::computeEnergyRatio(indirect, refIndirect);
-    out["energy_ratio"] = std::isfinite(energy) ? nlohmann::ordered_json(energy) : nullptr;
+    out["energy_ratio"] = jsonNumber(energy);
 
     if (!spec.regions.empty()) {
         nlohmann::ordered_json regions;
@@ -69,8 +75,7 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
             // The indirect energy of this region alone (e.g. a surface lit only indirectly)
             const double regionEnergy =
                 metrics::computeEnergyRatio(indirect, refIndirect, &*ro.mask);
-            entry["energy_ratio"] =
-                std::isfinite(regionEnergy) ? nlohmann::ordered_json(regionEnergy) : nullptr;
+            entry["energy_ratio"] = jsonNumber(regionEnergy);
             entry["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, ro));
             if (bounces != 0 && !reference.indirect.empty()) {
                 ro.referenceStdError = &reference.indirectStdError;
@@ -116,7 +121,14 @@ nlohmann::ordered_json computeDirectMetrics(const std::vector<ImageLayer>& layer
     options.ppd = spec.ppd;
     options.resampleFlip = false;
     options.referenceStdError = &directReference.finalStdError;
-    return metrics::toJson(metrics::computeMetrics(sum, directReference.final, options));
+    nlohmann::ordered_json out =
+        metrics::toJson(metrics::computeMetrics(sum, directReference.final, options));
+    // Energy and leaks of the shared direct light (docs/metrics.md, "Direct-light accuracy")
+    const metrics::DirectAccuracy a = metrics::directAccuracy(sum, directReference.final);
+    out["energy_ratio"] = jsonNumber(a.energyRatio);
+    out["shadow_leak"] = jsonNumber(a.shadowLeak);
+    out["missing"] = jsonNumber(a.missing);
+    return out;
 }
 
 }  // namespace gilab::exp

@@ -230,7 +230,10 @@ nlohmann::ordered_json writeReferencePreview(Context& c, const SceneEntry& entry
     };
     auto exr = [&](const std::string& file, const Image& mean, const Image& stdError) {
         once(file, [&](const std::string& path) {
-            writeExrWithMainImage(path, {{"final", mean}, {"final_stderr", stdError}}, "final");
+            writeExrWithMainImage(
+                path, {{"final", mean}, {"final_stderr", stdError}}, "final",
+                {{kPixelFilterAttribute,
+                  ref::pixelFilterName(c.config.reference.settings.pixelFilter)}});
         });
     };
     auto png = [&](const std::string& file, const Image& image) {
@@ -450,7 +453,8 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
     if (!sameVpl.is_null()) result["metrics"]["same_vpl"] = sameVpl;
 
-    writeExrWithMainImage((tmp / "output.exr").string(), layers, "final");
+    writeExrWithMainImage((tmp / "output.exr").string(), layers, "final",
+                          {{kPixelFilterAttribute, "center"}});
     writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
     writePngTonemapped((tmp / "indirect.png").string(), layers[1].image, tm);
     result["outputs"] = {{"exr", "output.exr"},

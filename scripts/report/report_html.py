@@ -13,8 +13,8 @@ from report_analysis import (Sweep, best_runs, by_device, by_scene, param_value,
                              params_text, pareto_fronts, pareto_ties)
 from report_assets import BODY_JS, CSS, HEAD_JS, MAGMA_STOPS
 from report_animation import animation_anchor, animation_html
-from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, esc,
-                           fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
+from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link, esc,
+                           fmt_fixed, fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
                            rel_url, scene_anchor, status_badge, swatch, update_badge, with_bar)
 from report_data import Run, dig, num, text
 from report_device import (DYNAMIC_FRAME, device_groups, device_label, dynamic_clock,
@@ -190,6 +190,31 @@ def _scene_resolution(runs: list[Run]) -> str:
     return ""
 
 
+def _direct_accuracy_line(runs: list[Run], page: Page) -> str:
+    """The shared direct light's own error on this scene (metrics.direct of the `direct` run, else
+    of any run): its energy against the path tracer's emission + direct, the light it puts where
+    the path tracer has shadow, and its HDR-FLIP. No technique can get below it."""
+    ok = [r for r in runs if r.status == "ok" and dig(r.data, "metrics", "direct") is not None]
+    if not ok:
+        return ""
+    run = next((r for r in ok if r.technique == "direct"), ok[0])
+    direct = dig(run.data, "metrics", "direct")
+    energy, leak = num(dig(direct, "energy_ratio")), num(dig(direct, "shadow_leak"))
+    parts = []
+    if energy is not None:
+        parts.append(f"energy {fmt_fixed(energy, 4)}× the path tracer's emission + direct")
+    if leak is not None:
+        parts.append(f"{fmt_fixed(100.0 * leak, 2)} % of its light in pixels the path tracer "
+                     "has in shadow")
+    if run.direct.flip_mean is not None:
+        parts.append(f"HDR-FLIP {fmt_flip(run.direct.flip_mean)}")
+    if not parts:
+        return ""
+    return ('<p class="direct-line">Shared direct light (every technique\'s direct layer): '
+            + ", ".join(parts) + ". No technique's error on this scene can fall below it ("
+            + doc_link(page, "shared_passes.md") + ").</p>")
+
+
 def scene_section(scene: str, runs: list[Run], page: Page) -> str:
     measured = [r for r in runs if r.measured]
     basis = page.basis(scene)
@@ -232,6 +257,7 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
                      f'{animation_anchor(scene)}">animation section</a>'
                      if dynamic_clock(measured) else "") + ".</p>")
     return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{basis_line}'
+            f'{_direct_accuracy_line(measured, page)}'
             f'{_exposure_bar()}<div class="cards">{"".join(cards)}</div>{"".join(details)}'
             f'{note}</section>')
 

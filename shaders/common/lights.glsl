@@ -19,11 +19,16 @@ struct PassLight {
     vec4 positionType;  // xyz position (not directional), w = PASS_LIGHT_*
     vec4 direction;     // xyz: travel direction (spot, directional) or emitter normal (sample);
                         // w: 1 = two-sided emitter sample
-    vec4 intensity;     // rgb: W/sr (point, spot), W/m^2 (directional), Le * area (sample)
+    vec4 intensity;     // rgb: W/sr (point, spot), W/m^2 (directional), Le * area (sample);
+                        // w: sample area / pi (the squared radius of its disk)
     vec4 cone;          // x cos(inner), y cos(outer) (spot)
     vec4 shadow;        // x SHADOW_* kind, y layer (2D) or cube index, z texel size factor,
                         // w 1 = orthographic (texel size = z) else perspective (z * distance)
-    vec4 bias;          // x constant, y slope (texels), z normal offset (texels), w PCF radius
+    vec4 bias;          // volume receivers (shadowVisibility): x constant, y slope (texels),
+                        // z normal offset (texels), w PCF radius
+    vec4 surfaceBias;   // surface receivers (shadowVisibilitySurface), the same four settings
+    vec4 cascades;      // x first cascade entry, y cascade count (directional lights),
+                        // z 1 = receiver-plane test for surface receivers
     vec4 origin;        // orthographic: xyz point on the entry plane (distance = dot(p - o, dir))
     mat4 viewProj;      // 2D maps: world -> Vulkan clip space (y down)
 };
@@ -44,7 +49,9 @@ float spotAttenuation(PassLight light, vec3 fromLight) {
 //   point:       E_perp = I / r^2
 //   spot:        E_perp = I * spotAttenuation / r^2
 //   directional: E_perp = E
-//   sample:      E_perp = Le * A_k * cos(theta_emitter) / r^2   (cosine-lobe intensity)
+//   sample:      E_perp = Le * A_k * cos(theta_emitter) / (r^2 + A_k / pi)
+//                (a disk of area A_k: exact on its axis, bounded by pi * Le as r -> 0, and the
+//                cosine-lobe point law E = I cos / r^2 once r is well above the disk's radius)
 // The irradiance on a receiver with normal n is E_perp * max(0, dot(n, wi)).
 vec3 lightIrradiancePerp(PassLight light, vec3 x, out vec3 wi, out float dist) {
     uint type = uint(light.positionType.w);
@@ -68,7 +75,7 @@ vec3 lightIrradiancePerp(PassLight light, vec3 x, out vec3 wi, out float dist) {
     } else if (type == PASS_LIGHT_EMITTER_SAMPLE) {
         float cosEmit = dot(light.direction.xyz, -wi);
         cosEmit = light.direction.w > 0.5 ? abs(cosEmit) : max(cosEmit, 0.0);
-        e *= cosEmit;
+        e = light.intensity.rgb * (cosEmit / (r2 + light.intensity.w));
     }
     return e;
 }
