@@ -193,7 +193,7 @@ def _scene_resolution(runs: list[Run]) -> str:
 def _direct_accuracy_line(runs: list[Run], page: Page) -> str:
     """The shared direct light's own error on this scene (metrics.direct of the `direct` run, else
     of any run): its energy against the path tracer's emission + direct, the light it puts where
-    the path tracer has shadow, and its HDR-FLIP. No technique can get below it."""
+    the path tracer has shadow, and its HDR-FLIP, part of every technique's error."""
     ok = [r for r in runs if r.status == "ok" and dig(r.data, "metrics", "direct") is not None]
     if not ok:
         return ""
@@ -211,7 +211,7 @@ def _direct_accuracy_line(runs: list[Run], page: Page) -> str:
     if not parts:
         return ""
     return ('<p class="direct-line">Shared direct light (every technique\'s direct layer): '
-            + ", ".join(parts) + ". No technique's error on this scene can fall below it ("
+            + ", ".join(parts) + ". It is part of every technique's error on this scene ("
             + doc_link(page, "shared_passes.md") + ").</p>")
 
 

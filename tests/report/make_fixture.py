@@ -364,6 +364,11 @@ GPU = {"name": "Fixture GPU (synthetic)", "type": "discrete", "driver": "fixture
 EXR_MAGIC = b"v/1\x01"  # the fixture's EXR files are placeholders: magic number only
 
 
+def direct_energy(scene: str) -> float:
+    """metrics.direct.energy_ratio of every run of the scene (the report shows it once)."""
+    return 0.9987 if area_lit(scene) else 1.0016
+
+
 def direct_layer_flip(spec: Spec) -> float:
     """The shared direct-light layer against emission+direct: the same for every technique."""
     samples = spec.shared.get("area_light_samples", 16)
@@ -482,6 +487,9 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
             metrics["indirect"] = metric_set(min(1.0, flip * 1.8), w * h, bars, spec.nan_pixels)
         if sweeps:  # newer runners: the direct-light layer vs. emission+direct
             metrics["direct"] = metric_set(direct_layer_flip(spec), w * h, bars)
+            # issue 27's direct-light accuracy: the same for every technique of a scene
+            metrics["direct"]["energy_ratio"] = direct_energy(spec.scene)
+            metrics["direct"]["shadow_leak"] = 0.0025 if area_lit(spec.scene) else 0.0042
         if sweeps and spec.scene == "cornell_box":
             metrics["regions"] = {name: region_metrics(spec, flip * f, w * h // 6, bars)
                                   for name, f in zip(REGIONS, (0.8, 1.4))}

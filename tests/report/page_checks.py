@@ -178,6 +178,23 @@ def check_images(checks: Any, results_dir: str, dom: str) -> None:
                  "the reference's matching indirect layer", str(missing[:4]))
 
 
+def check_direct_line(checks: Any, results_dir: str, dom: str) -> None:
+    """Every scene with metrics.direct states the shared direct light's energy and leak once."""
+    runs = results_by_key(results_dir)
+    expected = {}
+    for d in runs.values():
+        energy = dig(d, "metrics", "direct", "energy_ratio")
+        if energy is not None:
+            expected[d["scene"]["label"]] = (energy, dig(d, "metrics", "direct", "shadow_leak"))
+    lines = re.findall(r'<p class="direct-line">(.*?)</p>', dom, re.S)
+    missing = [scene for scene, (energy, leak) in expected.items()
+               if not any(f"energy {energy:.4f}×" in line and f"{100 * leak:.2f} %" in line
+                          for line in lines)]
+    checks.check(bool(expected) and not missing and len(lines) == len(expected),
+                 "every scene states the shared direct light's energy and leak (metrics.direct)",
+                 f"missing {missing}, {len(lines)} lines for {len(expected)} scenes")
+
+
 def svg_texts(path: str) -> list[str]:
     with open(path, encoding="utf-8") as f:
         svg = f.read()

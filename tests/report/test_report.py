@@ -245,6 +245,7 @@ def check_main(checks: Checks, tmp: str) -> None:
                  str({k: v for k, v in first_titles.items() if not right_title(k, v)}))
     page_checks.check_bases(checks, fixture, dom, "full")
     page_checks.check_images(checks, fixture, dom)
+    page_checks.check_direct_line(checks, fixture, dom)
     page_checks.check_device(checks, fixture, dom, page_checks.LAVAPIPE)
     page_checks.check_no_effect(checks, fixture, dom)
     page_checks.check_exr_links(checks, fixture, dom)
