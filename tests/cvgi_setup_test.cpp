@@ -720,7 +720,7 @@ TEST(CpuCvgiFormFactor, DiskIsExactForCoaxialDisk) {
 
 TEST(CpuCvgiFormFactor, DiskVersusExactSquareErrorTable) {
     // Relative error of diskFormFactor (A = a^2) against the exact square, printed as the table
-    // in docs/techniques/cvgi_setup.md; the bounds are the measured ones plus a small margin.
+    // in docs/techniques/cvgi.md; the bounds are the measured ones plus a small margin.
     // Receiver tilt "x": in the xz plane (across the source's tilt), "y": in the source's yz
     // tilt plane, both signs.
     struct Receiver {

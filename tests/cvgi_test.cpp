@@ -142,22 +142,114 @@ TEST_F(GpuCvgi, CameraOnlyMoveGathersOnlyNewlyVisibleVoxels) {
     }
 }
 
-// The one-bounce energy on the spot-lit box: with enough rays per face that few lit clusters are
-// missed, cvgi's indirect layer carries about the path tracer's one-bounce indirect energy.
-TEST_F(GpuCvgi, SpotCornellIndirectIsFiniteAndNearTheOneBounceReference) {
+// The one-bounce energy on the spot-lit box (issue 28). With enough rays per face that few lit
+// clusters are missed, the paper's gather carries about the path tracer's one-bounce indirect
+// energy; at its 128 rays it loses a share that grows with N (§4.3 samples each cluster with the
+// face's rays). The ray-weighted gather (ours) is near 1 at 128 rays at every N. The old
+// dominant-axis neighbour test gave 0.45 of the 1024-ray paper row: the bound below catches it.
+struct EnergyCase {
+    const char* gather;
+    const char* resolution;
+    const char* rays;
+    double lo, hi;
+};
+
+TEST_F(GpuCvgi, SpotCornellIndirectEnergyAgainstTheOneBounceReference) {
     const Scene scene = spotBox(32);
-    FrameHarness h(*m_ctx, scene, "cvgi", cvgiParams({{"rays_per_face", "1024"}}),
+    const double reference = test::oneBounceReferenceSum(scene, 256);
+    ASSERT_GT(reference, 0.0);
+    const EnergyCase cases[] = {
+        {"paper", "32", "1024", 0.85, 1.1},
+        {"paper", "64", "128", 0.2, 0.7},  // the paper's sampling loss, reproduced
+        {"ray_weighted", "32", "128", 0.9, 1.12},
+        {"ray_weighted", "64", "128", 0.9, 1.12},
+    };
+    for (const EnergyCase& c : cases) {
+        FrameHarness h(*m_ctx, scene, "cvgi",
+                       cvgiParams({{"gather", c.gather},
+                                   {"voxel_resolution", c.resolution},
+                                   {"rays_per_face", c.rays}}),
+                       defaultSharedParams());
+        h.setup();
+        h.renderFrame();
+        const double cvgi = test::indirectLayerSum(h.readLayers());
+        ASSERT_GE(cvgi, 0.0);
+        std::printf(
+            "spot Cornell 32^2, gather %s, N = %s, %s rays: cvgi / reference = %.3f "
+            "(rays per lit entry %.2f)\n",
+            c.gather, c.resolution, c.rays, cvgi / reference, stat(h, "rays_per_lit_entry"));
+        EXPECT_GT(cvgi / reference, c.lo) << c.gather << " N " << c.resolution << " " << c.rays;
+        EXPECT_LT(cvgi / reference, c.hi) << c.gather << " N " << c.resolution << " " << c.rays;
+        EXPECT_EQ(stat(h, "lit_clusters_never_hit_percent"), 0.0);  // a closed box
+        EXPECT_GT(stat(h, "rays_seeing_lit_percent"), 5.0);
+    }
+}
+
+// Fig. 10's neighbour test removes voxels behind an occupied neighbour toward the light, not the
+// walls lit at an angle (their dominant-axis neighbour is the next voxel of the same wall).
+TEST_F(GpuCvgi, NeighbourTestKeepsWallsLitAtAnAngle) {
+    const Scene scene = spotBox(32);
+    auto litVoxels = [&](const char* test) {
+        FrameHarness h(*m_ctx, scene, "cvgi",
+                       cvgiParams({{"neighbour_test", test}, {"rays_per_face", "32"}}),
+                       defaultSharedParams());
+        h.setup();
+        h.renderFrame();
+        return stat(h, "lit_voxels");
+    };
+    const double on = litVoxels("true"), off = litVoxels("false");
+    std::printf("lit voxels: neighbour test on %.0f, off %.0f\n", on, off);
+    EXPECT_GT(on, 0.75 * off);  // the dominant-axis reading kept 0.48
+    EXPECT_LT(on, off);         // and it still removes some
+}
+
+// Issue 28: the paper's Gaussian gives non-lit neighbours weight 0 and renormalises, so a dark
+// face takes its lit neighbours' mean, also through a wall; gaussian_visibility (ours, default)
+// skips neighbours behind occupied voxels. Two rooms, door closed, seen from the dark room: the
+// path tracer has 0 there (README: the shared direct light is 0 too).
+TEST_F(GpuCvgi, GaussianDoesNotSpreadLightThroughAClosedWall) {
+    Scene scene = loadSceneFile(
+        std::string(GILAB_SOURCE_DIR) + "/scenes/stress/two_rooms_door.json", "room_b_closed");
+    scene.settings.width = 32;
+    scene.settings.height = 32;
+    auto darkRoomLight = [&](const char* visibility) {
+        FrameHarness h(*m_ctx, scene, "cvgi",
+                       cvgiParams({{"voxel_resolution", "64"},
+                                   {"rays_per_face", "32"},
+                                   {"gaussian_visibility", visibility}}),
+                       defaultSharedParams());
+        h.setup();
+        h.renderFrame();
+        return test::indirectLayerSum(h.readLayers());
+    };
+    const double paperFilter = darkRoomLight("false"), ours = darkRoomLight("true");
+    std::printf("indirect light in the closed room: paper filter %.4g, ours %.4g\n", paperFilter,
+                ours);
+    EXPECT_GT(paperFilter, 0.0);         // the leak this guards against
+    EXPECT_LT(ours, 0.3 * paperFilter);  // measured 0.17 at 64x64 (4.8 % vs 28 % of room B lit)
+}
+
+// Bad input (issue 28): a wide frame asks for a camera distance map wider than the device allows;
+// the map is clamped to the limit, said in a note, and the run stays validation-clean.
+TEST_F(GpuCvgi, CameraMapIsClampedToTheDeviceLimit) {
+    Scene scene = spotBox(8);
+    const uint32_t maxSide = m_ctx->properties().limits.maxImageDimension2D;
+    scene.settings.width = int(std::min(maxSide, 4096u));
+    scene.settings.height = 1;
+    const uint32_t side = 8 * maxSide / uint32_t(scene.settings.width);  // 8x the limit wide
+    FrameHarness h(*m_ctx, scene, "cvgi",
+                   cvgiParams({{"camera_map_size", std::to_string(side)},
+                               {"rays_per_face", "8"},
+                               {"voxel_resolution", "32"}}),
                    defaultSharedParams());
     h.setup();
     h.renderFrame();
-    const double cvgi = test::indirectLayerSum(h.readLayers());
-    ASSERT_GE(cvgi, 0.0);
-    const double reference = test::oneBounceReferenceSum(scene, 256);
-    ASSERT_GT(reference, 0.0);
-    std::printf("spot Cornell 32^2, N = 32, 1024 rays: indirect energy cvgi / reference = %.3f\n",
-                cvgi / reference);
-    EXPECT_GT(cvgi / reference, 0.5);
-    EXPECT_LT(cvgi / reference, 1.3);
+    bool noted = false;
+    for (const std::string& n : h.notes())
+        noted = noted || n.find("clamped to the device's image limit") != std::string::npos;
+    EXPECT_TRUE(noted);
+    for (const ImageLayer& l : h.readLayers())
+        EXPECT_TRUE(countNonFinite(l.image).allFinite()) << l.name;
 }
 
 TEST_F(GpuCvgi, UnsupportedLightsGiveAReason) {

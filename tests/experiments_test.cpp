@@ -467,6 +467,30 @@ TEST_F(GpuRunner, KeepsResultsSkipsFinishedRunsAndRedoesMissingOnes) {
     EXPECT_EQ(s.alreadyFinished, 1u);
 }
 
+// A sweep point this device cannot run (a buffer above maxStorageBufferRange: vct's 512^3
+// voxelizer needs 512 MiB per accumulator, lavapipe allows 128 MiB) is recorded as unsupported
+// with the limit as its reason, and the experiment goes on to the next run.
+TEST_F(GpuRunner, ARunAboveADeviceLimitIsUnsupportedAndTheOthersRun) {
+    nlohmann::json j = baseConfig();
+    j["name"] = "device_limit";
+    j["techniques"] = {{{"technique", "vct"}, {"params", {{"voxel_resolution", 512}}}},
+                       {{"technique", "direct"}}};
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary s = runExperiment(options());
+    ASSERT_EQ(s.ran, 2u);
+    for (const nlohmann::json& r : RunStore(s.dir).loadFinished()) {
+        if (r["technique"]["id"] == "direct" || r["status"] == "ok") {
+            EXPECT_EQ(r["status"], "ok");  // a device with 512 MiB bindings runs both
+            continue;
+        }
+        EXPECT_EQ(r["status"], "unsupported");
+        const std::string reason = r["reason"];
+        EXPECT_NE(reason.find("device limit"), std::string::npos) << reason;
+        EXPECT_NE(reason.find("maxStorageBufferRange"), std::string::npos) << reason;
+        EXPECT_EQ(r["validation"]["errors"], 0);
+    }
+}
+
 TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
     const RunnerSummary a = runExperiment(options(0, 2));
     const RunnerSummary b = runExperiment(options(1, 2));

@@ -116,9 +116,10 @@ GpuScene::GpuScene(Context& ctx, const Scene& scene) : m_ctx(&ctx), m_scene(&sce
     VkDeviceSize texelBytes = packed.texels.size() * 4;
     VkDeviceSize maxRange = ctx.properties().limits.maxStorageBufferRange;
     if (texelBytes > maxRange) {
-        throw Error("scene '" + scene.name + "': textures need " + std::to_string(texelBytes) +
-                    " bytes with mips, more than the " + std::to_string(maxRange) +
-                    "-byte storage buffer limit of " + ctx.deviceName());
+        throw DeviceLimitError("scene '" + scene.name + "': textures need " +
+                               std::to_string(texelBytes) + " bytes with mips, more than the " +
+                               std::to_string(maxRange) + "-byte storage buffer limit of " +
+                               ctx.deviceName());
     }
     m_textureMeta = Buffer(ctx, packed.meta.size() * sizeof(glm::uvec4), kStorage,
                            MemoryUsage::DeviceLocal, "scene/textureMeta");

@@ -213,8 +213,8 @@ ThinningStats thinCurveSkeleton(std::vector<uint8_t>& object, const GridDims& di
     return stats;
 }
 
-bool isSimplePoint(const std::vector<uint8_t>& object, const GridDims& dims, uint32_t x,
-                   uint32_t y, uint32_t z) {
+bool isSimplePoint(const std::vector<uint8_t>& object, const GridDims& dims, uint32_t x, uint32_t y,
+                   uint32_t z) {
     validate(object.size(), dims, "isSimplePoint");
     if (x >= dims.nx || y >= dims.ny || z >= dims.nz) {
         throw Error("isSimplePoint: voxel (" + std::to_string(x) + "," + std::to_string(y) + "," +

@@ -17,9 +17,10 @@ constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
 void checkRange(vk::Context& ctx, VkDeviceSize bytes, const std::string& what) {
     const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
     if (bytes > range) {
-        throw Error("voxel fragment lists: " + what + " needs " + std::to_string(bytes >> 20) +
-                    " MiB in one binding, above the device's maxStorageBufferRange (" +
-                    std::to_string(range >> 20) + " MiB); use a lower voxel resolution");
+        throw DeviceLimitError("voxel fragment lists: " + what + " needs " +
+                               std::to_string(bytes >> 20) +
+                               " MiB in one binding, above the device's maxStorageBufferRange (" +
+                               std::to_string(range >> 20) + " MiB); use a lower voxel resolution");
     }
 }
 
@@ -93,8 +94,9 @@ void VoxelFragmentLists::grow(uint32_t capacity) {
 
 std::vector<GpuVoxelFragment> VoxelFragmentLists::readFragments(uint32_t count) {
     if (count > m_capacity) {
-        throw Error("voxel fragment lists: " + std::to_string(count) +
-                    " fragments requested, only " + std::to_string(m_capacity) + " stored");
+        throw DeviceLimitError("voxel fragment lists: " + std::to_string(count) +
+                               " fragments requested, only " + std::to_string(m_capacity) +
+                               " stored");
     }
     return m_fragments.downloadVector<GpuVoxelFragment>(count);
 }

@@ -81,11 +81,12 @@ void Voxelizer::createAccumulation(const VoxelizerOptions& options) {
             ++largest;
         while (largest > 0 && VkDeviceSize(largest) * largest * largest * 4 > maxRange)
             --largest;
-        throw Error("voxel_resolution = " + std::to_string(m_grid.resolution()) +
-                    " is too large for this device: one voxelizer accumulator needs " +
-                    std::to_string(planeBytes >> 20) + " MiB, above maxStorageBufferRange (" +
-                    std::to_string(maxRange >> 20) + " MiB); the largest grid here is " +
-                    std::to_string(largest) + "^3");
+        throw DeviceLimitError("voxel_resolution = " + std::to_string(m_grid.resolution()) +
+                               " is too large for this device: one voxelizer accumulator needs " +
+                               std::to_string(planeBytes >> 20) +
+                               " MiB, above maxStorageBufferRange (" +
+                               std::to_string(maxRange >> 20) + " MiB); the largest grid here is " +
+                               std::to_string(largest) + "^3");
     }
     for (uint32_t k = 0; k < kAccumulatorWords; ++k) {
         m_accumulators.emplace_back(

@@ -397,13 +397,21 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
                           info.id + " on " + run.scene->label,
                       size_t(c.config.timing.warmupFrames + c.config.timing.timedFrames));
-    const SetupTiming setup = harness->setup();
+    SetupTiming setup;
     std::vector<FrameTiming> frames;
     const int total = c.config.timing.warmupFrames + c.config.timing.timedFrames;
-    for (int i = 0; i < total; ++i) {
-        FrameTiming t = harness->renderFrame();
-        if (i >= c.config.timing.warmupFrames) frames.push_back(std::move(t));
-        progress.update(size_t(i + 1));
+    try {
+        setup = harness->setup();
+        for (int i = 0; i < total; ++i) {
+            FrameTiming t = harness->renderFrame();
+            if (i >= c.config.timing.warmupFrames) frames.push_back(std::move(t));
+            progress.update(size_t(i + 1));
+        }
+    } catch (const DeviceLimitError& e) {  // valid parameters this device cannot run
+        progress.finish();
+        result["reason"] = std::string("device limit: ") + e.what();
+        harness.reset();
+        return commitResult(c, result, tmp, key, {.supported = false});
     }
     progress.finish();
 

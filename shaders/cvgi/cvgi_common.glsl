@@ -39,7 +39,9 @@ layout(set = 0, binding = 0, std140) uniform CvgiUniforms {
     uvec4 options;   // x Gaussian radius, y neighbour test, z interpolation, w frame height
     mat4 cameraViewProj;
     vec4 cameraEye;  // xyz
-    uvec4 packing;   // x 1: faceClusters holds 16-bit ids, two per word
+    uvec4 packing;   // x 1: faceClusters holds 16-bit ids, two per word; y 1: ray-weighted
+                     // gather (faceWeights); z rays per face; w 1: the Gaussian skips
+                     // neighbours behind occupied voxels
 } u;
 
 layout(set = 0, binding = 1, std430) readonly buffer VoxelIndex { uint voxelIndex[]; };
@@ -60,6 +62,9 @@ layout(set = 0, binding = 15, std430) buffer GatherList { uint gatherList[]; };
 layout(set = 0, binding = 16, scalar) readonly buffer PassLights { PassLight passLights[]; };
 layout(set = 0, binding = 17) uniform sampler2D emitterMap;
 layout(set = 0, binding = 18) uniform sampler2D cameraMap;
+// Per visibility entry: the cosine sum of the face's rays that met the cluster's front
+// (ray-weighted gather only; a placeholder otherwise).
+layout(set = 0, binding = 19, std430) readonly buffer FaceWeights { float faceWeights[]; };
 
 ivec3 cvgiAxisDir(uint face) {
     ivec3 d = ivec3(0);

@@ -4,6 +4,9 @@
 // neighbours of each camera-visible voxel. Empty neighbours, neighbours not gathered for this
 // emitter state and faces that gathered nothing ("non-lit") get weight 0, then the weights are
 // renormalised (no shadow leaks). Run twice: faceIrradiance -> faceTemp -> faceFiltered.
+// gaussian_visibility (ours, u.packing.w): a neighbour also gets weight 0 when the straight path
+// between the two faces' front cells crosses an occupied voxel, so a lit face does not spread
+// through a wall (docs/techniques/cvgi.md, "The Gaussian filter").
 #include "cvgi/cvgi_common.glsl"
 
 layout(local_size_x = 64) in;
@@ -24,6 +27,18 @@ void store(uint face, vec4 e) {
     else faceFiltered[face] = e;
 }
 
+// True when no occupied voxel lies strictly between cells a and b (sampled at the cells the
+// segment passes through, one per step of its longest axis).
+bool pathOpen(ivec3 a, ivec3 b) {
+    ivec3 d = b - a;
+    int steps = max(abs(d.x), max(abs(d.y), abs(d.z)));
+    for (int k = 1; k < steps; ++k) {
+        ivec3 p = a + ivec3(round(vec3(d) * (float(k) / float(steps))));
+        if (p != a && p != b && cvgiIndexAt(p) != CVGI_EMPTY) return false;
+    }
+    return true;
+}
+
 void main() {
     uint t = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * pc.stride;
     if (t >= u.counts.x * 6u) return;
@@ -36,6 +51,8 @@ void main() {
     int radius = int(u.options.x);
     float inv2s2 = 0.5 / (u.biases.w * u.biases.w);
     ivec3 c = cvgiCoord(i);
+    ivec3 front = c + cvgiAxisDir(f);
+    bool visibility = u.packing.w != 0u;
     vec3 sum = vec3(0.0);
     float weight = 0.0;
     for (int z = -radius; z <= radius; ++z)
@@ -45,6 +62,7 @@ void main() {
                 if (j == CVGI_EMPTY || (voxelState[j] & CVGI_PROCESSED) == 0u) continue;
                 vec4 e = source(6u * j + f);
                 if (e.w <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;  // non-lit face
+                if (visibility && !pathOpen(front, front + ivec3(x, y, z))) continue;
                 float w = exp(-float(x * x + y * y + z * z) * inv2s2);
                 sum += w * e.rgb;
                 weight += w;

@@ -6,16 +6,25 @@
 // face-to-cluster form factor. A cluster whose AABB is nearer than the threshold is gathered voxel
 // by voxel instead (its lit voxels, each a source of area s^2 on its own axis face).
 // E = sum B A cos cos / (pi r^2 + A) in grid units (irradiance, W/m^2; docs/techniques/cvgi.md).
+// gather = ray_weighted (ours, u.packing.y): the Monte Carlo estimate over the same rays instead,
+// E = (2 pi / rays) sum over the hits of L cos = (2 / rays) sum_c Bmean_c W_c, with Bmean_c the
+// cluster's radiosity summed over its lit voxels and divided by all its voxels (a ray meets any
+// of them) and W_c the cosine sum of the face's rays that met the cluster's front (set-up).
 #include "cvgi/cvgi_common.glsl"
 
 layout(local_size_x = 64) in;
 
 shared vec3 partial[64];
 
-vec3 gatherCluster(uint c, vec3 x, vec3 n) {
+vec3 gatherCluster(uint c, uint entry, vec3 x, vec3 n) {
     CvgiClusterLight light = clusterLight[c];
     if (light.radiosity.w <= 0.0) return vec3(0.0);  // not lit
     CvgiCluster cl = clusters[c];
+    if (u.packing.y != 0u) {
+        float meanRadiosityScale = 1.0 / float(max(cl.aabbMax.w, 1));
+        return light.radiosity.rgb * (meanRadiosityScale * 2.0 * faceWeights[entry] /
+                                      float(max(u.packing.z, 1u)));
+    }
     vec3 lo = vec3(cl.aabbMin.xyz), hi = vec3(cl.aabbMax.xyz) + 1.0;
     vec3 outside = max(max(lo - x, x - hi), vec3(0.0));
     if (length(outside) >= u.biases.z) {
@@ -47,7 +56,8 @@ void main() {
         vec3 x = vec3(cvgiCoord(v)) + 0.5 + 0.5 * n;  // face centre
         uint first = faceOffset[face], count = faceOffset[face + 1u] - first;
         vec3 e = vec3(0.0);
-        for (uint k = lid; k < count; k += 64u) e += gatherCluster(cvgiFaceCluster(first + k), x, n);
+        for (uint k = lid; k < count; k += 64u)
+            e += gatherCluster(cvgiFaceCluster(first + k), first + k, x, n);
         partial[lid] = e;
         barrier();
         for (uint stride = 32u; stride > 0u; stride >>= 1u) {

@@ -23,6 +23,7 @@
 
 #include "core/technique/technique.h"
 #include "techniques/cvgi/cvgi_settings.h"
+#include "techniques/cvgi/cvgi_setup.h"
 
 namespace gilab {
 
@@ -44,6 +45,7 @@ private:
     void recordUpdateStats(TechniqueContext& ctx);
 
     std::unique_ptr<CvgiGpu> m_gpu;
+    cvgi::ClusterSightings m_sightings;  // what the faces' rays see, for the update stats
 };
 
 }  // namespace gilab

@@ -1,6 +1,7 @@
 #include "techniques/cvgi/cvgi_gpu.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 
 #include "core/passes/gbuffer.h"
@@ -36,7 +37,8 @@ struct CvgiUniforms {
     glm::uvec4 options;
     glm::mat4 cameraViewProj;
     glm::vec4 cameraEye;
-    glm::uvec4 packing;  // x 1 = face cluster ids packed two per word
+    glm::uvec4 packing;  // x 1 = face cluster ids packed two per word, y 1 = ray-weighted
+                         // gather, z rays per face
 };
 
 struct LitPush {
@@ -63,9 +65,10 @@ vk::Buffer upload(vk::Context& ctx, const std::vector<T>& data, const std::strin
     const VkDeviceSize bytes = std::max<VkDeviceSize>(data.size() * sizeof(T), 16);
     const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
     if (bytes > range) {
-        throw Error(name + ": " + std::to_string(bytes >> 20) +
-                    " MiB in one binding, above the device's maxStorageBufferRange (" +
-                    std::to_string(range >> 20) + " MiB); lower voxel_resolution or rays_per_face");
+        throw DeviceLimitError(name + ": " + std::to_string(bytes >> 20) +
+                               " MiB in one binding, above the device's maxStorageBufferRange (" +
+                               std::to_string(range >> 20) +
+                               " MiB); lower voxel_resolution or rays_per_face");
     }
     vk::Buffer b(ctx, bytes, kStorage, vk::MemoryUsage::DeviceLocal, name);
     b.uploadVector(data);
@@ -75,9 +78,9 @@ vk::Buffer upload(vk::Context& ctx, const std::vector<T>& data, const std::strin
 vk::Buffer storage(vk::Context& ctx, VkDeviceSize bytes, const std::string& name) {
     const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
     if (bytes > range) {
-        throw Error(name + ": " + std::to_string(bytes >> 20) +
-                    " MiB in one binding, above the device's maxStorageBufferRange (" +
-                    std::to_string(range >> 20) + " MiB); lower voxel_resolution");
+        throw DeviceLimitError(name + ": " + std::to_string(bytes >> 20) +
+                               " MiB in one binding, above the device's maxStorageBufferRange (" +
+                               std::to_string(range >> 20) + " MiB); lower voxel_resolution");
     }
     return vk::Buffer(ctx, std::max<VkDeviceSize>(bytes, 16), kStorage,
                       vk::MemoryUsage::DeviceLocal, name);
@@ -131,6 +134,10 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
     } else {
         m_faceClusters = upload(ctx, vis.clusters, tag + "/face_clusters");
     }
+    m_raysPerFace = vis.rays;
+    m_faceWeights = settings.gather == CvgiSettings::Gather::RayWeighted
+                        ? upload(ctx, vis.cosineSums, tag + "/face_weights")
+                        : upload(ctx, std::vector<float>{0.0f}, tag + "/face_weights");
     // Per-update state.
     const VkDeviceSize v = m_voxelCount;
     m_voxelLight = storage(ctx, v * 16, tag + "/voxel_light");
@@ -152,10 +159,17 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
         if (uint32_t(shadows.lights()[i].shadow.x) == kShadowMap2D) m_emitters.push_back(i);
     m_emitterMap = std::make_unique<DistanceMap>(ctx, scene, settings.shadowMapSize,
                                                  settings.shadowMapSize, tag + "/emitter_map");
+    // The camera map keeps the frame's aspect, within the device's image limit (its projection is
+    // the camera's whatever its size: a clamped axis only has fewer texels).
     const float aspect = float(shared.width()) / float(std::max(shared.height(), 1u));
-    const uint32_t camH = settings.cameraMapSize;
-    const uint32_t camW = std::max(1u, uint32_t(float(camH) * aspect + 0.5f));
-    m_cameraMap = std::make_unique<DistanceMap>(ctx, scene, camW, camH, tag + "/camera_map");
+    const uint32_t maxSide = ctx.properties().limits.maxImageDimension2D;
+    const uint32_t wantH = settings.cameraMapSize;
+    const double wantW = std::max(1.0, std::round(double(wantH) * double(aspect)));
+    m_cameraMapWidth = uint32_t(std::min<double>(wantW, maxSide));
+    m_cameraMapHeight = std::min(wantH, maxSide);
+    m_cameraMapClamped = m_cameraMapWidth != wantW || m_cameraMapHeight != wantH;
+    m_cameraMap = std::make_unique<DistanceMap>(ctx, scene, m_cameraMapWidth, m_cameraMapHeight,
+                                                tag + "/camera_map");
     vk::SamplerDesc sd;
     sd.filter = VK_FILTER_NEAREST;
     sd.mipmap = VK_SAMPLER_MIPMAP_MODE_NEAREST;
@@ -169,6 +183,7 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
         bindings.push_back({b, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs});
     bindings.push_back({17, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs});
     bindings.push_back({18, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs});
+    bindings.push_back({19, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs});
     m_setLayout = vk::DescriptorSetLayout(ctx, bindings, tag + "/passes");
     m_set = vk::DescriptorSet(ctx, m_setLayout, 0, tag + "/passes");
     m_set.writeUniformBuffer(0, m_uniforms);
@@ -181,6 +196,7 @@ CvgiGpu::CvgiGpu(vk::Context& ctx, const vk::GpuScene& scene, SharedPasses& shar
         m_set.writeBuffer(b + 1, *buffers[b]);
     m_set.writeSampledImage(17, m_emitterMap->image().view(), m_sampler.handle());
     m_set.writeSampledImage(18, m_cameraMap->image().view(), m_sampler.handle());
+    m_set.writeBuffer(19, m_faceWeights);
     m_frameLayout = vk::DescriptorSetLayout(ctx,
                                             {{0, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
                                              {1, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs},
@@ -227,7 +243,9 @@ void CvgiGpu::writeUniforms() {
     const uint32_t radius = m_settings.gaussianKernel > 1 ? m_settings.gaussianKernel / 2 : 0;
     u.options = glm::uvec4(radius, m_settings.neighbourTest ? 1u : 0u,
                            m_settings.interpolation ? 1u : 0u, m_shared.height());
-    u.packing = glm::uvec4(m_packedFaceClusters ? 1u : 0u, 0u, 0u, 0u);
+    u.packing = glm::uvec4(m_packedFaceClusters ? 1u : 0u,
+                           m_settings.gather == CvgiSettings::Gather::RayWeighted ? 1u : 0u,
+                           m_raysPerFace, m_settings.gaussianVisibility ? 1u : 0u);
     u.cameraViewProj = m_cameraViewProj;
     u.cameraEye = glm::vec4(m_cameraEye, 0.0f);
     m_uniforms.upload(&u, sizeof(u));
@@ -339,6 +357,15 @@ void CvgiGpu::recordFinalFrame(VkCommandBuffer cmd, vk::Image& indirect) {
     vk::memoryBarrier(cmd);
 }
 
+std::vector<uint32_t> CvgiGpu::readLitCounts() {
+    std::vector<float> light(size_t(m_clusterCount) * 8);
+    if (!light.empty()) m_clusterLight.download(light.data(), light.size() * sizeof(float));
+    std::vector<uint32_t> lit(m_clusterCount);
+    for (uint32_t c = 0; c < m_clusterCount; ++c)
+        lit[c] = uint32_t(light[size_t(c) * 8 + 3] + 0.5f);
+    return lit;
+}
+
 CvgiCounters CvgiGpu::readCounters() {
     uint32_t words[kCounterWords] = {};
     m_counters.download(words, sizeof(words));
@@ -349,8 +376,8 @@ uint64_t CvgiGpu::finalBytes() const {
     uint64_t sum = 0;
     for (const vk::Buffer* b :
          {&m_voxelIndex, &m_hashedPosition, &m_voxels, &m_clusters, &m_clusterVoxels, &m_faceOffset,
-          &m_faceClusters, &m_voxelLight, &m_clusterLight, &m_voxelState, &m_faceIrradiance,
-          &m_faceTemp, &m_faceFiltered, &m_counters, &m_gatherList})
+          &m_faceClusters, &m_faceWeights, &m_voxelLight, &m_clusterLight, &m_voxelState,
+          &m_faceIrradiance, &m_faceTemp, &m_faceFiltered, &m_counters, &m_gatherList})
         sum += b->size();
     return sum;
 }

@@ -69,6 +69,12 @@ public:
     void recordFinalFrame(VkCommandBuffer cmd, vk::Image& indirect);
 
     CvgiCounters readCounters();
+    /** Lit voxels per cluster after the last emitter update (0 = not lit). */
+    std::vector<uint32_t> readLitCounts();
+    /** The camera distance map's size, and whether the device's image limit clamped it. */
+    uint32_t cameraMapWidth() const { return m_cameraMapWidth; }
+    uint32_t cameraMapHeight() const { return m_cameraMapHeight; }
+    bool cameraMapClamped() const { return m_cameraMapClamped; }
     /** Bytes of the buffers the bounce and the frame use (the paper's "Mem. Final"). */
     uint64_t finalBytes() const;
     /** Bytes of the compacted per-face visibility (offsets + cluster ids). */
@@ -86,13 +92,16 @@ private:
     CvgiSettings m_settings;
     uint32_t m_voxelCount = 0, m_clusterCount = 0;
     bool m_packedFaceClusters = false;
+    uint32_t m_raysPerFace = 0;
+    uint32_t m_cameraMapWidth = 0, m_cameraMapHeight = 0;
+    bool m_cameraMapClamped = false;
     std::vector<uint32_t> m_emitters;  // pass light indices with a 2D distance view
     glm::mat4 m_cameraViewProj{1.0f};
     glm::vec3 m_cameraEye{0.0f};
 
     vk::Buffer m_uniforms;
     vk::Buffer m_voxelIndex, m_hashedPosition, m_voxels, m_clusters, m_clusterVoxels, m_faceOffset,
-        m_faceClusters;
+        m_faceClusters, m_faceWeights;
     vk::Buffer m_voxelLight, m_clusterLight, m_voxelState, m_faceIrradiance, m_faceTemp,
         m_faceFiltered, m_counters, m_gatherList;
     std::unique_ptr<DistanceMap> m_emitterMap, m_cameraMap;

@@ -48,9 +48,18 @@ std::vector<ParamSpec> cvgiParamSpecs() {
         intParam("gaussian_passes", 2, 0, 4, "", "Gaussian passes (paper 2)"),
         floatParam("gaussian_sigma_voxels", 1.0, 0.1, 8.0, "voxels",
                    "Gaussian standard deviation (not given; notes 000 §8.10)"),
+        boolParam("gaussian_visibility", true,
+                  "ours: a neighbour's face enters the Gaussian only if the straight path between "
+                  "the two faces' front cells crosses no occupied voxel (false = the paper's "
+                  "filter, which spreads lit faces through walls up to the kernel radius)"),
         boolParam("interpolation", true,
                   "bilinear interpolation of the face irradiance between neighbour voxels "
                   "(§4.5; false = Fig. 12 row 5)"),
+        enumParam("gather", "paper", {"paper", "ray_weighted"},
+                  "light bounce estimator: paper = every listed lit cluster through the "
+                  "face-to-cluster form factor (§4.4); ray_weighted = ours, the rays' Monte Carlo "
+                  "estimate (2 pi / rays) sum over hits of the cluster's mean radiance x cos",
+                  kRebuild),
     };
 }
 
@@ -70,7 +79,10 @@ CvgiSettings cvgiSettingsFrom(const ParamSet& p) {
     s.gaussianKernel = uint32_t(p.getInt("gaussian_kernel"));
     s.gaussianPasses = uint32_t(p.getInt("gaussian_passes"));
     s.gaussianSigmaVoxels = float(p.getFloat("gaussian_sigma_voxels"));
+    s.gaussianVisibility = p.getBool("gaussian_visibility");
     s.interpolation = p.getBool("interpolation");
+    s.gather = p.getEnum("gather") == "ray_weighted" ? CvgiSettings::Gather::RayWeighted
+                                                     : CvgiSettings::Gather::Paper;
     if (s.gaussianKernel > 1 && s.gaussianKernel % 2 == 0) {
         throw Error("cvgi: gaussian_kernel = " + std::to_string(s.gaussianKernel) +
                     " must be odd (a centred kernel: 3, 5, 7, 9), or 0 / 1 for no filtering");

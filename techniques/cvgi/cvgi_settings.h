@@ -28,7 +28,13 @@ struct CvgiSettings {
     uint32_t gaussianKernel = 5;  // 0 or 1 = off, else odd
     uint32_t gaussianPasses = 2;
     float gaussianSigmaVoxels = 1.0f;
-    bool interpolation = true;  // §4.5 bilinear face interpolation
+    bool gaussianVisibility = true;  // ours: no filtering across occupied voxels
+    bool interpolation = true;       // §4.5 bilinear face interpolation
+    // The light bounce's estimator (set-up: the weights are built with the visibility lists):
+    // Paper = each listed lit cluster through the face-to-cluster form factor (§4.4, Fig. 5);
+    // RayWeighted = ours: the Monte Carlo estimate over the same rays, E = (2 pi / rays) sum over
+    // the hits of the hit cluster's mean radiance times the ray's cosine.
+    enum class Gather { Paper, RayWeighted } gather = Gather::Paper;
 };
 
 std::vector<ParamSpec> cvgiParamSpecs();

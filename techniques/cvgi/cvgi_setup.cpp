@@ -429,9 +429,10 @@ std::vector<glm::ivec3> rayDeltas(uint32_t rays, uint32_t n) {
  */
 struct FaceDedup {
     std::vector<uint32_t> stamp;
+    std::vector<uint32_t> slot;  // the cluster's entry in the face's list (valid when stamped)
     uint32_t face = 0;
 
-    explicit FaceDedup(uint32_t clusterIds) : stamp(clusterIds, 0) {}
+    explicit FaceDedup(uint32_t clusterIds) : stamp(clusterIds, 0), slot(clusterIds, 0) {}
     void nextFace() { ++face; }
     bool firstTime(uint32_t cluster) {
         if (stamp[cluster] == face) return false;
@@ -440,20 +441,46 @@ struct FaceDedup {
     }
 };
 
+/** A face's entries as traceFace fills them: ids, ray counts and facing cosine sums. */
+struct FaceEntries {
+    std::vector<uint32_t>& clusters;
+    std::vector<uint32_t>& hits;
+    std::vector<float>& cosineSums;
+};
+
 /**
- * Appends the distinct clusters seen from face f of voxel i to `list`, in first-hit ray order.
- * Rays start at c + axis (the voxel in front of the face) and stop at the first occupied voxel,
- * the start included (a buried face sees only its neighbour's cluster), or on leaving the grid.
- * An unassigned voxel blocks and adds nothing.
+ * Appends the distinct clusters seen from face f of voxel i to `out`, in first-hit ray order,
+ * with each cluster's ray count and the cosines (to the face's axis) of its rays that met the
+ * cluster's front (`cosines[r]`, `directions[r]` of ray r in world axes). Rays start at c + axis
+ * (the voxel in front of the face) and stop at the first occupied voxel, the start included (a
+ * buried face sees only its neighbour's cluster), or on leaving the grid. An unassigned voxel
+ * blocks and adds nothing. Returns whether the face is buried.
  */
-void traceFace(const CompactVoxels& v, const Clusters& cl, const glm::ivec3* deltas, uint32_t rays,
-               uint32_t i, uint32_t f, FaceDedup& dedup, std::vector<uint32_t>& list) {
+bool traceFace(const CompactVoxels& v, const Clusters& cl, const glm::ivec3* deltas,
+               const glm::vec3* directions, const float* cosines, uint32_t rays, uint32_t i,
+               uint32_t f, FaceDedup& dedup, FaceEntries& out) {
     dedup.nextFace();
+    const size_t first = out.clusters.size();
+    auto add = [&](uint32_t owner, uint32_t r) {
+        if (dedup.firstTime(owner)) {
+            dedup.slot[owner] = uint32_t(out.clusters.size() - first);
+            out.clusters.push_back(owner);
+            out.hits.push_back(0);
+            out.cosineSums.push_back(0.0f);
+        }
+        const size_t e = first + dedup.slot[owner];
+        ++out.hits[e];
+        const bool front =
+            owner >= cl.normal.size() || glm::dot(cl.normal[owner], directions[r]) < 0.0f;
+        if (front) out.cosineSums[e] += cosines[r];
+    };
     const glm::ivec3 start = v.coord(i) + axisDirection(f);
-    if (!v.inside(start)) return;
+    if (!v.inside(start)) return false;
     if (const uint32_t hit = v.at(start); hit != kEmpty) {  // buried: every ray stops here
-        if (cl.owner[hit] != kEmpty) list.push_back(cl.owner[hit]);
-        return;
+        if (cl.owner[hit] != kEmpty)
+            for (uint32_t r = 0; r < rays; ++r)
+                add(cl.owner[hit], r);
+        return true;
     }
     const size_t n = v.resolution;
     for (uint32_t r = 0; r < rays; ++r) {
@@ -462,10 +489,11 @@ void traceFace(const CompactVoxels& v, const Clusters& cl, const glm::ivec3* del
             const uint32_t hit = v.indexOf[size_t(p.x) + n * (size_t(p.y) + n * size_t(p.z))];
             if (hit == kEmpty) return true;
             const uint32_t owner = cl.owner[hit];
-            if (owner != kEmpty && dedup.firstTime(owner)) list.push_back(owner);
+            if (owner != kEmpty) add(owner, r);
             return false;
         });
     }
+    return false;
 }
 
 /** One more than the largest owner id (the Clusters may carry only `owner`). */
@@ -537,6 +565,26 @@ uint32_t paperInitialClusters(uint32_t resolution) {
     return uint32_t(std::max(1.0, std::round(double(best->k) * scale * scale * scale)));
 }
 
+ClusterSightings clusterSightings(const FaceVisibility& visibility, uint32_t clusterIds) {
+    ClusterSightings out;
+    out.rayHits.assign(clusterIds, 0);
+    out.faceHits.assign(clusterIds, 0);
+    out.rays = visibility.rays;
+    const size_t faces = visibility.buried.size();
+    for (size_t f = 0; f < faces; ++f) {
+        if (visibility.buried[f]) continue;
+        ++out.openFaces;
+        for (uint32_t e = visibility.offset[f]; e < visibility.offset[f + 1]; ++e) {
+            const uint32_t c = visibility.clusters[e];
+            if (c >= clusterIds) continue;
+            out.rayHits[c] += visibility.hits[e];
+            ++out.faceHits[c];
+            ++out.openEntries;
+        }
+    }
+    return out;
+}
+
 std::vector<glm::vec3> hemisphereDirections(uint32_t rays) {
     std::vector<glm::vec3> dirs(rays);
     for (uint32_t i = 0; i < rays; ++i) {
@@ -577,40 +625,62 @@ FaceVisibility faceVisibility(const CompactVoxels& voxels, const Clusters& clust
                     std::to_string(voxels.count()));
     const uint32_t rays = params.raysPerFace, count = voxels.count();
     const std::vector<glm::ivec3> deltas = rayDeltas(rays, voxels.resolution);
+    const std::vector<glm::vec3> local = hemisphereDirections(rays);
+    std::vector<glm::vec3> directions(6 * size_t(rays));
+    std::vector<float> cosines(rays);
+    for (uint32_t r = 0; r < rays; ++r) {
+        cosines[r] = local[r].z;
+        for (uint32_t f = 0; f < 6; ++f)
+            directions[f * size_t(rays) + r] = toFaceFrame(local[r], f);
+    }
     const uint32_t idRange = clusterIdRange(clusters);
 
     // Fixed chunks of voxels, each filled by one task and concatenated in order: the result does
     // not depend on the thread count.
     constexpr uint32_t kChunk = 64;
     const uint32_t chunks = (count + kChunk - 1) / kChunk;
-    std::vector<std::vector<uint32_t>> chunkCounts(chunks), chunkLists(chunks);
+    struct Chunk {
+        std::vector<uint32_t> counts, clusters, hits;
+        std::vector<float> cosineSums;
+        std::vector<uint8_t> buried;
+    };
+    std::vector<Chunk> chunk(chunks);
     tbb::parallel_for(uint32_t(0), chunks, [&](uint32_t c) {
         const uint32_t begin = c * kChunk, end = std::min(count, begin + kChunk);
-        std::vector<uint32_t>& counts = chunkCounts[c];
-        std::vector<uint32_t>& list = chunkLists[c];
+        Chunk& k = chunk[c];
+        FaceEntries entries{k.clusters, k.hits, k.cosineSums};
         FaceDedup dedup(idRange);
-        counts.reserve(6 * size_t(end - begin));
+        k.counts.reserve(6 * size_t(end - begin));
         for (uint32_t i = begin; i < end; ++i) {
             for (uint32_t f = 0; f < 6; ++f) {
-                const size_t before = list.size();
-                traceFace(voxels, clusters, &deltas[f * size_t(rays)], rays, i, f, dedup, list);
-                counts.push_back(uint32_t(list.size() - before));
+                const size_t before = k.clusters.size();
+                const bool buried = traceFace(voxels, clusters, &deltas[f * size_t(rays)],
+                                              &directions[f * size_t(rays)], cosines.data(), rays,
+                                              i, f, dedup, entries);
+                k.counts.push_back(uint32_t(k.clusters.size() - before));
+                k.buried.push_back(buried ? 1 : 0);
             }
         }
     });
 
     FaceVisibility out;
+    out.rays = rays;
     out.offset.reserve(6 * size_t(count) + 1);
     out.offset.push_back(0);
     for (uint32_t c = 0; c < chunks; ++c) {
-        for (uint32_t n : chunkCounts[c]) {
+        for (uint32_t n : chunk[c].counts) {
             out.offset.push_back(out.offset.back() + n);
             out.maxPerFace = std::max(out.maxPerFace, n);
         }
-        out.clusters.insert(out.clusters.end(), chunkLists[c].begin(), chunkLists[c].end());
+        out.clusters.insert(out.clusters.end(), chunk[c].clusters.begin(), chunk[c].clusters.end());
+        out.hits.insert(out.hits.end(), chunk[c].hits.begin(), chunk[c].hits.end());
+        out.cosineSums.insert(out.cosineSums.end(), chunk[c].cosineSums.begin(),
+                              chunk[c].cosineSums.end());
+        out.buried.insert(out.buried.end(), chunk[c].buried.begin(), chunk[c].buried.end());
     }
     out.raysTraced = uint64_t(count) * 6 * rays;
     out.uncompactedEntries = uint64_t(count) * 6 * rays;
+    out.paperEntries = uint64_t(count) * uint64_t(voxels.resolution) * 6;
     return out;
 }
 

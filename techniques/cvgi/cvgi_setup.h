@@ -4,9 +4,9 @@
  *   heuristicNormals()  the axis-aligned "heuristic normal" of each voxel (§4.2, Fig. 7)
  *   clusterVoxels()     Algorithm 1, a deterministic emulation of the GPU SLIC-like race
  *   faceVisibility()    per voxel face, the clusters seen by 3D Bresenham rays (§4.3)
- * Every choice the paper leaves open is listed in docs/techniques/cvgi_setup.md. Not reproduced
- * (authors' code only, not in the paper): the cluster-merge pass and the voxel-face penalty.
- * Results are deterministic and independent of the TBB thread count.
+ * Every choice the paper leaves open is listed in docs/techniques/cvgi.md ("Set-up on the CPU").
+ * Not reproduced (authors' code only, not in the paper): the cluster-merge pass and the voxel-face
+ * penalty. Results are deterministic and independent of the TBB thread count.
  */
 #include <cstdint>
 #include <vector>
@@ -64,9 +64,17 @@ struct VisibilityParams {
 struct FaceVisibility {
     std::vector<uint32_t> offset;    // [6V + 1] CSR, face f of voxel i at 6 * i + f
     std::vector<uint32_t> clusters;  // distinct cluster ids per face, in first-hit ray order
-    uint64_t raysTraced = 0;  // V * 6 * rays (a buried face's rays all stop at the start voxel)
+    // Per entry (parallel to `clusters`): the face's rays that stopped in that cluster, and the
+    // sum of their cosines to the face's axis over the rays that met the cluster's front (its
+    // mean normal against the ray): the `ray_weighted` gather's weights (ours, not the paper's).
+    std::vector<uint32_t> hits;
+    std::vector<float> cosineSums;
+    std::vector<uint8_t> buried;  // [6V] 1 = the voxel in front of the face is occupied
+    uint32_t rays = 0;            // rays per face
+    uint64_t raysTraced = 0;      // V * 6 * rays (a buried face's rays all stop at the start voxel)
     uint32_t maxPerFace = 0;
-    uint64_t uncompactedEntries = 0;  // V * 6 * rays: the brute-force layout (§4.3 "14-22%")
+    uint64_t uncompactedEntries = 0;  // V * 6 * rays: one entry per ray and face
+    uint64_t paperEntries = 0;        // V * N * 6: the paper's brute-force layout (§4.3 "14-22%")
 
     uint32_t countOf(uint32_t voxel, uint32_t face) const {
         return offset[6 * voxel + face + 1] - offset[6 * voxel + face];
@@ -76,6 +84,22 @@ struct FaceVisibility {
 /** §4.3: the clusters each voxel face sees. Throws gilab::Error on bad params. */
 FaceVisibility faceVisibility(const CompactVoxels& voxels, const Clusters& clusters,
                               const VisibilityParams& params);
+
+/**
+ * What the open faces (not buried) of a FaceVisibility see, summed per cluster id: the sampling
+ * statistics of §4.3's lists (ours), kept after the set-up so each emitter update can say how
+ * many of its lit clusters any face can gather and what share of the rays see one.
+ */
+struct ClusterSightings {
+    std::vector<uint64_t> rayHits;   // [cluster id] rays of open faces that stopped in it
+    std::vector<uint32_t> faceHits;  // [cluster id] open faces whose lists hold it
+    uint64_t openFaces = 0;
+    uint64_t openEntries = 0;  // distinct (open face, cluster) pairs
+    uint32_t rays = 0;         // rays per face
+
+    double clustersPerFace() const { return openFaces ? double(openEntries) / openFaces : 0.0; }
+};
+ClusterSightings clusterSightings(const FaceVisibility& visibility, uint32_t clusterIds);
 
 /**
  * `rays` unit directions about +z, uniform in solid angle (Hammersley: cos theta = 1 - i/rays,

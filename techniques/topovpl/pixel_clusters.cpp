@@ -13,10 +13,10 @@ PixelClusters::PixelClusters(vk::Context& ctx, GBuffer& gbuffer, const SceneTopo
     const VkDeviceSize bytes = VkDeviceSize(t.voxelCluster.size()) * 4;
     const VkDeviceSize range = ctx.properties().limits.maxStorageBufferRange;
     if (bytes > range)
-        throw Error(tag + ": the " + std::to_string(t.dims.nx) + "^3 cluster grid needs " +
-                    std::to_string(bytes >> 20) +
-                    " MiB in one binding, above the device's maxStorageBufferRange (" +
-                    std::to_string(range >> 20) + " MiB); lower voxel_resolution");
+        throw DeviceLimitError(tag + ": the " + std::to_string(t.dims.nx) +
+                               "^3 cluster grid needs " + std::to_string(bytes >> 20) +
+                               " MiB in one binding, above the device's maxStorageBufferRange (" +
+                               std::to_string(range >> 20) + " MiB); lower voxel_resolution");
     m_voxelClusters = vk::Buffer(
         ctx, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
         vk::MemoryUsage::DeviceLocal, tag + "/voxel_clusters");

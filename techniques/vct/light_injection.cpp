@@ -649,8 +649,8 @@ void LightInjection::ensureDenseResources(TechniqueContext& ctx) {
     if (!m_flux.empty()) return;
     const VkDeviceSize planeBytes = VkDeviceSize(m_grid.voxelCount()) * 4;
     if (planeBytes > ctx.vk.properties().limits.maxStorageBufferRange) {
-        throw Error("vct: voxel_resolution = " + std::to_string(m_grid.resolution()) +
-                    " needs a flux plane above the device's maxStorageBufferRange");
+        throw DeviceLimitError("vct: voxel_resolution = " + std::to_string(m_grid.resolution()) +
+                               " needs a flux plane above the device's maxStorageBufferRange");
     }
     const VkBufferUsageFlags usage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                                      VK_BUFFER_USAGE_TRANSFER_DST_BIT |
