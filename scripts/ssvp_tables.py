@@ -4,8 +4,13 @@ results folder:
 
   Table I   per-stage GPU ms: G-buffer (the shared pass), misc (RSM, first-bounce VPLs, K-means,
             second-bounce VPLs), paraboloid, shade (gathering + blur), total; per cluster count
-  error     each run against the two-bounce reference (what ssvp claims) and the full one:
-            relMSE and mean HDR-FLIP, the clamp's removed energy, the K-means iterations
+  error     each run against the two-bounce reference (what ssvp claims; bounces = 1 runs too,
+            from metrics.final_vs_bounces), against the reference of the bounces the run claims
+            and the full one: relMSE and mean HDR-FLIP, the clamp's removed energy, the K-means
+            iterations and whether they converged
+  same VPLs the run's last-frame VPLs shaded on the CPU with exact shadow rays and unshadowed
+            (metrics.same_vpl, with "same_vpl_reference": true in the config): indirect energy of
+            the run and of the unshadowed VPLs over the exact one, relMSE against it
   relative  the paper's own comparison: every run against the C = 32 run with the same other
             parameters (the paper: HDR-VDP-2 RMSE; here relMSE and HDR-FLIP via `gilab compare`)
 
@@ -48,6 +53,48 @@ def metric(r, group, name):
     m = r.get("metrics", {}).get(group, {})
     v = m.get(name)
     return v.get("mean") if isinstance(v, dict) else v
+
+
+def ladder(r, bounces, name):
+    """A metric of the final image against the reference of `bounces` bounces."""
+    v = r.get("metrics", {}).get("final_vs_bounces", {}).get(str(bounces), {}).get(name)
+    return v.get("mean") if isinstance(v, dict) else v
+
+
+def per_bounce(rows):
+    """Issue 29's per-bounce table, one line per bounces = 2 run that has a bounces = 1 twin."""
+    def mean_of(r):
+        return r["metrics"]["same_vpl"].get("indirect", {}).get("mean")
+
+    ones = {}
+    for r in rows:
+        p = r["technique"]["params"]
+        if p["bounces"] == 1:
+            ones[(r["scene"]["label"], key_without(p, "bounces"))] = r
+    out = []
+    for r in rows:
+        p = r["technique"]["params"]
+        one = ones.get((r["scene"]["label"], key_without(p, "bounces")))
+        if p["bounces"] != 2 or one is None:
+            continue
+        lad = r["metrics"].get("final_vs_bounces", {})
+        means = [lad.get(str(b), {}).get("reference_mean") for b in (0, 1, 2)]
+        by = r["metrics"]["same_vpl"].get("by_bounce", {})
+        if None in means or mean_of(r) is None or mean_of(one) is None or not by:
+            continue
+        r1, r2 = means[1] - means[0], means[2] - means[1]
+
+        def ratio(v, d):
+            return None if v is None or not d else v / d
+        first = mean_of(one)
+        second = mean_of(r) - first
+        b1, b2 = by.get("1", {}), by.get("2", {})
+        out.append("\t".join([r["scene"]["label"], str(p["clusters"]),
+                              str(p["second_bounce_vpls"]), fmt(ratio(first, r1), 3),
+                              fmt(ratio(b1.get("exact_mean"), r1), 3),
+                              fmt(ratio(second, r2), 3), fmt(ratio(b2.get("exact_mean"), r2), 3),
+                              fmt(ratio(b2.get("unshadowed_mean"), r2), 3)]))
+    return out
 
 
 def key_without(params, drop):
@@ -107,20 +154,46 @@ def main(folder, gilab):
         print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
                           str(p["bounces"])] + [fmt(ms[k]) for k in STAGES] +
                          [fmt(total), fmt(ms["direct"])]))
-    print("\nError (final image) against the claimed-bounce reference (2b: bounces = 2, else 1) "
-          "and the full one")
-    print("\t".join(["scene", "C", "N2", "bounces", "relMSE_2b", "HDR-FLIP_2b", "relMSE_full",
-                     "HDR-FLIP_full", "energy_ratio", "clamped_%", "kmeans_it", "valid_vpls"]))
+    print("\nError (final image) against the two-bounce reference (every row), the reference of "
+          "the bounces the run claims and the full one")
+    print("\t".join(["scene", "C", "N2", "bounces", "relMSE_2b", "HDR-FLIP_2b", "relMSE_claimed",
+                     "HDR-FLIP_claimed", "relMSE_full", "HDR-FLIP_full", "energy_ratio",
+                     "clamped_%", "kmeans_it", "kmeans_converged", "valid_vpls"]))
     for r in rows:
         p = r["technique"]["params"]
         s = r.get("stats", {})
         print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
-                         str(p["bounces"]), fmt(metric(r, "final", "rel_mse"), 4), fmt(metric(r, "final", "flip"), 4),
+                         str(p["bounces"]), fmt(ladder(r, 2, "rel_mse"), 4),
+                         fmt(ladder(r, 2, "flip"), 4), fmt(metric(r, "final", "rel_mse"), 4),
+                         fmt(metric(r, "final", "flip"), 4),
                          fmt(metric(r, "final_vs_full", "rel_mse"), 4),
                          fmt(metric(r, "final_vs_full", "flip"), 4),
                          fmt(r.get("metrics", {}).get("energy_ratio"), 3),
                          fmt(s.get("clamped_energy_percent"), 2), fmt(s.get("kmeans_iterations"), 0),
+                         fmt(s.get("kmeans_converged"), 0),
                          fmt(s.get("valid_first_bounce_vpls"), 0)]))
+    same = [r for r in rows if r.get("metrics", {}).get("same_vpl")]
+    if same:
+        print("\nSame VPLs with exact shadow rays (metrics.same_vpl; indirect layers)")
+        print("\t".join(["scene", "C", "N2", "bounces", "vpls", "energy_vs_exact",
+                         "unshadowed_vs_exact", "relMSE_vs_exact", "relMSE_unshadowed"]))
+        for r in same:
+            p = r["technique"]["params"]
+            sv = r["metrics"]["same_vpl"]
+            ind = sv.get("indirect", {})
+            print("\t".join([r["scene"]["label"], str(p["clusters"]),
+                             str(p["second_bounce_vpls"]), str(p["bounces"]),
+                             fmt(sv.get("vpls"), 0), fmt(ind.get("energy_ratio"), 3),
+                             fmt(ind.get("energy_ratio_unshadowed"), 3), fmt(ind.get("rel_mse"), 4),
+                             fmt(ind.get("rel_mse_unshadowed"), 4)]))
+    bounce_rows = per_bounce(same)
+    if bounce_rows:
+        print("\nPer bounce, over the path tracer's bounce layer (R1, R2): ssvp, the same VPLs with "
+              "shadow rays (exact), and without (unshadowed)")
+        print("\t".join(["scene", "C", "N2", "first_ssvp/R1", "first_exact/R1",
+                         "second_ssvp/R2", "second_exact/R2", "second_unshadowed/R2"]))
+        for line in bounce_rows:
+            print(line)
     lines = relative(rows, folder, gilab)
     if lines:
         print("\nRelative to C = 32 (the paper's Fig. 6 comparison; paper HDR-VDP-2 RMSE: "

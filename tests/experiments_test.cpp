@@ -539,6 +539,40 @@ TEST_F(GpuRunner, SameVplReferenceGivesTableIIForVplTechniques) {
     EXPECT_EQ(vplRuns, 1);
 }
 
+// Issue 29's per-bounce accounting: the same-VPL light of ssvp's two bounces, shaded apart, adds
+// up to the total, and the bounce ladder's reference means grow with each bounce (R1, R2 > 0).
+TEST_F(GpuRunner, SameVplReferenceSplitsTheBouncesAndTheLadderGivesTheirReferences) {
+    nlohmann::json j = baseConfig();
+    j["name"] = "same_vpl_bounces";
+    j["scenes"] = {{{"scene", std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot"},
+                    {"resolution", {32, 32}}}};
+    j["metrics"] = {{"same_vpl_reference", true}};
+    j["techniques"] = {{{"technique", "ssvp"}, {"params", {{"clusters", 8}, {"bounces", 2}}}}};
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary s = runExperiment(options());
+    ASSERT_EQ(s.ran, 1u);
+    for (const nlohmann::json& r : RunStore(s.dir).loadFinished()) {
+        ASSERT_EQ(r["status"], "ok");
+        const nlohmann::json& v = r["metrics"]["same_vpl"];
+        const nlohmann::json& by = v["by_bounce"];
+        ASSERT_TRUE(by.contains("1") && by.contains("2"));
+        EXPECT_GT(by["1"]["vpls"].get<double>(), 0.0);
+        EXPECT_GT(by["2"]["vpls"].get<double>(), 0.0);
+        const double total = v["indirect"]["exact_mean"].get<double>();
+        const double parts =
+            by["1"]["exact_mean"].get<double>() + by["2"]["exact_mean"].get<double>();
+        EXPECT_GT(total, 0.0);
+        EXPECT_NEAR(parts, total, 1e-5 * total);
+        EXPECT_GE(by["2"]["unshadowed_mean"].get<double>(), by["2"]["exact_mean"].get<double>());
+        const nlohmann::json& ladder = r["metrics"]["final_vs_bounces"];
+        const double m0 = ladder["0"]["reference_mean"].get<double>();
+        const double m1 = ladder["1"]["reference_mean"].get<double>();
+        const double m2 = ladder["2"]["reference_mean"].get<double>();
+        EXPECT_GT(m1, m0);
+        EXPECT_GT(m2, m1);
+    }
+}
+
 TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {
     nlohmann::json j = baseConfig();
     j["name"] = "anim";

@@ -101,8 +101,19 @@ nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers
     for (int bounces : {0, 1, 2}) {
         const MatchedReference matched = references.match(bounces);
         options.referenceStdError = &matched.finalStdError;
-        out[std::to_string(bounces)] =
+        nlohmann::ordered_json entry =
             metrics::toJson(metrics::computeMetrics(final, matched.final, options));
+        // Mean RGB radiance of this reference: differences of consecutive entries are the
+        // path tracer's bounce layers (R1 = mean(1) - mean(0), R2 = mean(2) - mean(1)).
+        double sum = 0.0;
+        size_t n = 0;
+        for (float v : matched.final.values()) {
+            if (!std::isfinite(v)) continue;
+            sum += v;
+            ++n;
+        }
+        entry["reference_mean"] = n > 0 ? sum / double(n) : 0.0;
+        out[std::to_string(bounces)] = entry;
     }
     return out;
 }

@@ -87,8 +87,37 @@ nlohmann::ordered_json computeSameVplReference(FrameHarness& harness, const Scen
     Progress progress("same-VPL reference: " + std::to_string(valid) + " VPLs x " +
                           std::to_string(w) + "x" + std::to_string(h) + " shadow rays",
                       1000);
-    const ref::VplReferenceResult r = ref::shadeVplsWithShadowRays(
-        embree, in, [&](double f) { progress.update(size_t(f * 1000.0)); });
+    // One pass per bounce (flux.w: 1 or 2), so the exact light is known bounce by bounce; the
+    // totals are their sums (each VPL is shaded once either way).
+    ref::VplReferenceResult r;
+    r.exact.assign(size_t(w) * size_t(h), glm::vec4(0.0f));
+    r.unshadowed = r.exact;
+    nlohmann::ordered_json byBounce;
+    const std::vector<GpuVpl> all = std::move(in.vpls);
+    for (int bounce : {1, 2}) {
+        in.vpls.clear();
+        for (const GpuVpl& v : all)
+            if ((v.flux.w > 1.5f ? 2 : 1) == bounce) in.vpls.push_back(v);
+        if (in.vpls.empty()) continue;
+        const ref::VplReferenceResult part = ref::shadeVplsWithShadowRays(
+            embree, in,
+            [&](double f) { progress.update(size_t((f + double(bounce - 1)) * 500.0)); });
+        for (size_t i = 0; i < r.exact.size(); ++i) {
+            r.exact[i] += part.exact[i];
+            r.unshadowed[i] += part.unshadowed[i];
+        }
+        r.rays += part.rays;
+        r.seconds += part.seconds;
+        r.invalidPixels = std::max(r.invalidPixels, part.invalidPixels);
+        r.invalidVpls += part.invalidVpls;
+        size_t count = 0;
+        for (const GpuVpl& v : in.vpls)
+            count += v.position.w >= 0.5f ? 1 : 0;
+        byBounce[std::to_string(bounce)] = {
+            {"vpls", count},
+            {"exact_mean", meanOf(toRgb(part.exact, w, h))},
+            {"unshadowed_mean", meanOf(toRgb(part.unshadowed, w, h))}};
+    }
     progress.finish();
 
     const Image exact = toRgb(r.exact, w, h);
@@ -118,7 +147,12 @@ nlohmann::ordered_json computeSameVplReference(FrameHarness& harness, const Scen
         {"rel_mse", relMse(*indirect, exact)},
         {"rel_mse_unshadowed", relMse(unshadowed, exact)},
         {"energy_ratio", exactMean > 0.0 ? meanOf(*indirect) / exactMean : 0.0},
-        {"energy_ratio_unshadowed", exactMean > 0.0 ? meanOf(unshadowed) / exactMean : 0.0}};
+        {"energy_ratio_unshadowed", exactMean > 0.0 ? meanOf(unshadowed) / exactMean : 0.0},
+        {"mean", meanOf(*indirect)},
+        {"exact_mean", exactMean}};
+    // Mean RGB radiance of the VPLs of each bounce, exact and unshadowed (per-bounce accounting:
+    // scripts/ssvp_tables.py sets them beside the path tracer's bounce layers).
+    out["by_bounce"] = byBounce;
     layers.push_back({"vpl_exact", exact});
     layers.push_back({"vpl_unshadowed", unshadowed});
     return out;
