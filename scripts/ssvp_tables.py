@@ -90,11 +90,23 @@ def per_bounce(rows):
         second = mean_of(r) - first
         b1, b2 = by.get("1", {}), by.get("2", {})
         out.append("\t".join([r["scene"]["label"], str(p["clusters"]),
-                              str(p["second_bounce_vpls"]), fmt(ratio(first, r1), 3),
+                              str(p["second_bounce_vpls"]), variant(p), fmt(ratio(first, r1), 3),
                               fmt(ratio(b1.get("exact_mean"), r1), 3),
                               fmt(ratio(second, r2), 3), fmt(ratio(b2.get("exact_mean"), r2), 3),
                               fmt(ratio(b2.get("unshadowed_mean"), r2), 3)]))
     return out
+
+
+def variant(params):
+    """The issue-29 options a run sets away from their defaults (\"-\" for none)."""
+    tags = []
+    if params.get("interleave", 4) != 4:
+        tags.append(f"I={params['interleave']}")
+    if params.get("interleave_subsets", "blocks") != "blocks":
+        tags.append(params["interleave_subsets"])
+    if params.get("map_members", "keep") != "keep":
+        tags.append(params["map_members"])
+    return ",".join(tags) or "-"
 
 
 def key_without(params, drop):
@@ -154,16 +166,28 @@ def main(folder, gilab):
         print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
                           str(p["bounces"])] + [fmt(ms[k]) for k in STAGES] +
                          [fmt(total), fmt(ms["direct"])]))
+    print("\nTable I as stage shares of the total (lavapipe, not a reproduction; the paper at "
+          "C = 8 on a GTX 1060: shade 74 %, paraboloid 17 %)")
+    print("\t".join(["scene", "C", "N2"] + [k + "_%" for k in STAGES]))
+    for r in rows:
+        p = r["technique"]["params"]
+        if p["bounces"] != 2 or variant(p) != "-":
+            continue
+        ms = stage_ms(r)
+        total = sum(ms[k] for k in STAGES) or 1.0
+        print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"])] +
+                         [fmt(100.0 * ms[k] / total, 1) for k in STAGES]))
     print("\nError (final image) against the two-bounce reference (every row), the reference of "
           "the bounces the run claims and the full one")
-    print("\t".join(["scene", "C", "N2", "bounces", "relMSE_2b", "HDR-FLIP_2b", "relMSE_claimed",
-                     "HDR-FLIP_claimed", "relMSE_full", "HDR-FLIP_full", "energy_ratio",
-                     "clamped_%", "kmeans_it", "kmeans_converged", "valid_vpls"]))
+    print("\t".join(["scene", "C", "N2", "bounces", "variant", "relMSE_2b", "HDR-FLIP_2b",
+                     "relMSE_claimed", "HDR-FLIP_claimed", "relMSE_full", "HDR-FLIP_full",
+                     "energy_ratio", "clamped_%", "kmeans_it", "kmeans_converged", "warmup_run",
+                     "valid_vpls", "map_sees_members_%", "shading_map_sees_%"]))
     for r in rows:
         p = r["technique"]["params"]
         s = r.get("stats", {})
         print("\t".join([r["scene"]["label"], str(p["clusters"]), str(p["second_bounce_vpls"]),
-                         str(p["bounces"]), fmt(ladder(r, 2, "rel_mse"), 4),
+                         str(p["bounces"]), variant(p), fmt(ladder(r, 2, "rel_mse"), 4),
                          fmt(ladder(r, 2, "flip"), 4), fmt(metric(r, "final", "rel_mse"), 4),
                          fmt(metric(r, "final", "flip"), 4),
                          fmt(metric(r, "final_vs_full", "rel_mse"), 4),
@@ -171,18 +195,21 @@ def main(folder, gilab):
                          fmt(r.get("metrics", {}).get("energy_ratio"), 3),
                          fmt(s.get("clamped_energy_percent"), 2), fmt(s.get("kmeans_iterations"), 0),
                          fmt(s.get("kmeans_converged"), 0),
-                         fmt(s.get("valid_first_bounce_vpls"), 0)]))
+                         fmt(r.get("timing", {}).get("warmup_frames_run"), 0),
+                         fmt(s.get("valid_first_bounce_vpls"), 0),
+                         fmt(s.get("map_sees_member_flux_percent"), 1),
+                         fmt(s.get("shading_map_sees_member_flux_percent"), 1)]))
     same = [r for r in rows if r.get("metrics", {}).get("same_vpl")]
     if same:
         print("\nSame VPLs with exact shadow rays (metrics.same_vpl; indirect layers)")
-        print("\t".join(["scene", "C", "N2", "bounces", "vpls", "energy_vs_exact",
+        print("\t".join(["scene", "C", "N2", "bounces", "variant", "vpls", "energy_vs_exact",
                          "unshadowed_vs_exact", "relMSE_vs_exact", "relMSE_unshadowed"]))
         for r in same:
             p = r["technique"]["params"]
             sv = r["metrics"]["same_vpl"]
             ind = sv.get("indirect", {})
             print("\t".join([r["scene"]["label"], str(p["clusters"]),
-                             str(p["second_bounce_vpls"]), str(p["bounces"]),
+                             str(p["second_bounce_vpls"]), str(p["bounces"]), variant(p),
                              fmt(sv.get("vpls"), 0), fmt(ind.get("energy_ratio"), 3),
                              fmt(ind.get("energy_ratio_unshadowed"), 3), fmt(ind.get("rel_mse"), 4),
                              fmt(ind.get("rel_mse_unshadowed"), 4)]))
@@ -190,7 +217,7 @@ def main(folder, gilab):
     if bounce_rows:
         print("\nPer bounce, over the path tracer's bounce layer (R1, R2): ssvp, the same VPLs with "
               "shadow rays (exact), and without (unshadowed)")
-        print("\t".join(["scene", "C", "N2", "first_ssvp/R1", "first_exact/R1",
+        print("\t".join(["scene", "C", "N2", "variant", "first_ssvp/R1", "first_exact/R1",
                          "second_ssvp/R2", "second_exact/R2", "second_unshadowed/R2"]))
         for line in bounce_rows:
             print(line)

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <gtest/gtest.h>
+#include <map>
 
 #include <glm/glm.hpp>
 #include "tests/gpu_test_fixture.h"
@@ -134,6 +135,64 @@ TEST(CpuVplMath, HammersleyIsEquationOne) {
     EXPECT_EQ(vpl::hammersley(6, 8), glm::vec2(0.75f, 0.375f));
 }
 
+// Interleaved subsets of the Hammersley set (issue 29): every mode is a partition into equal
+// shares; blocks and fold give every subset points in each quarter of the RSM in x and in y,
+// fold gives one point of every elementary box of `stride` points to each subset (any aspect
+// ratio), and modulo, the version before, puts a whole subset into one strip of height 1/stride.
+TEST(CpuVplMath, InterleaveSubsetsPartitionTheSetAndSpreadOverTheRsm) {
+    const uint32_t n = 256, stride = 16;
+    for (uint32_t mode = 0; mode < 3; ++mode) {
+        std::vector<uint32_t> count(stride, 0);
+        std::vector<std::vector<int>> xq(stride, std::vector<int>(4, 0)), yq = xq;
+        for (uint32_t k = 0; k < n; ++k) {
+            const uint32_t s = vpl::interleaveSubset(k, n, stride, 0, mode);
+            ASSERT_LT(s, stride);
+            ++count[s];
+            const glm::vec2 u = vpl::hammersley(k, n);
+            ++xq[s][int(u.x * 4.0f)];
+            ++yq[s][int(u.y * 4.0f)];
+        }
+        for (uint32_t s = 0; s < stride; ++s) {
+            EXPECT_EQ(count[s], n / stride) << "mode " << mode;
+            if (mode == 2) continue;
+            for (int q = 0; q < 4; ++q) {
+                EXPECT_EQ(xq[s][q], 4) << "mode " << mode << " subset " << s;
+                EXPECT_EQ(yq[s][q], 4) << "mode " << mode << " subset " << s;
+            }
+        }
+    }
+    // fold: every elementary box of 2^a x 2^(4-a) cells (16 points) holds each subset once.
+    for (int a = 0; a <= 4; ++a) {
+        std::map<std::pair<int, int>, std::vector<int>> boxes;
+        for (uint32_t k = 0; k < n; ++k) {
+            const glm::vec2 u = vpl::hammersley(k, n);
+            const std::pair<int, int> cell{int(u.x * float(n >> 4 >> a)), int(u.y * float(1 << a))};
+            boxes[cell].push_back(int(vpl::interleaveSubset(k, n, stride, 3, 0)));
+        }
+        for (auto& [cell, subsets] : boxes) {
+            std::sort(subsets.begin(), subsets.end());
+            ASSERT_EQ(subsets.size(), stride);
+            for (uint32_t s = 0; s < stride; ++s)
+                EXPECT_EQ(subsets[s], int(s)) << "a " << a;
+        }
+    }
+    // modulo: subset 0 lies in one strip of y.
+    float lo = 1.0f, hi = 0.0f;
+    for (uint32_t k = 0; k < n; k += stride) {
+        lo = std::min(lo, vpl::hammersley(k, n).y);
+        hi = std::max(hi, vpl::hammersley(k, n).y);
+    }
+    EXPECT_LT(hi - lo, 1.0f / float(stride));
+    // A stride that is no power of two (I = 3) falls back to blocks: still a partition.
+    std::vector<uint32_t> nine(9, 0);
+    for (uint32_t k = 0; k < n; ++k)
+        ++nine[vpl::interleaveSubset(k, n, 9, 1, 0)];
+    for (uint32_t c : nine) {
+        EXPECT_GE(c, 24u);
+        EXPECT_LE(c, 32u);
+    }
+}
+
 // ---------------------------------------------------------------------------------------------
 // GPU
 // ---------------------------------------------------------------------------------------------
@@ -251,7 +310,7 @@ GatherRig gatherRig(vk::Context& ctx, Scene scene, const std::vector<GpuVpl>& vp
 std::vector<float> gather(vk::Context& ctx, GatherRig& r, const VplShadingSettings& s,
                           uint32_t count) {
     r.shading->setSettings(s);
-    ctx.submitAndWait([&](VkCommandBuffer cmd) { r.shading->recordGather(cmd, count); });
+    ctx.submitAndWait([&](VkCommandBuffer cmd) { r.shading->recordGather(cmd, count, count); });
     return r.shading->irradiance().readbackFloat(ctx);
 }
 

@@ -146,6 +146,20 @@ SceneChanges FrameHarness::setFrameState(const SceneFrameState& state) {
     return m_pending;
 }
 
+WarmupResult FrameHarness::warmUp(int frames, const std::function<void(int)>& onFrame) {
+    WarmupResult w;
+    w.requested = frames;
+    const auto more = [&] {
+        return frames > 0 && w.run < kMaxWarmupFrames && !m_technique->settled();
+    };
+    for (; w.run < frames || more(); ++w.run) {
+        renderFrame();
+        if (onFrame) onFrame(w.run);
+    }
+    w.settled = m_technique->settled();
+    return w;
+}
+
 FrameTiming FrameHarness::renderFrame() {
     if (!m_ready) throw Error("FrameHarness::renderFrame() called before setup()");
     FrameTiming t;

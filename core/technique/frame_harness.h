@@ -8,6 +8,7 @@
  * indirect layer. Composition final = emission + direct + indirect happens on read-back, in one
  * place (readLayers), so every technique is composed the same way.
  */
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -57,6 +58,13 @@ struct MemoryReport {
     std::vector<std::pair<std::string, uint64_t>> byTag;
 };
 
+/** What FrameHarness::warmUp() did. */
+struct WarmupResult {
+    int requested = 0;  // the config's warm-up frames
+    int run = 0;        // frames rendered (more while the technique had not settled)
+    bool settled = true;
+};
+
 class FrameHarness {
 public:
     FrameHarness(vk::Context& ctx, const Scene& scene, const std::string& techniqueId,
@@ -78,6 +86,13 @@ public:
      */
     SceneChanges setFrameState(const SceneFrameState& state);
     FrameTiming renderFrame();
+    /**
+     * Warm-up: renders `frames` frames, then more until the technique is settled() or
+     * kMaxWarmupFrames in all (none when frames = 0: an explicit cold start) (docs/timing.md
+     * "Warm-up"). onFrame(i) after each frame.
+     */
+    WarmupResult warmUp(int frames, const std::function<void(int)>& onFrame = {});
+    static constexpr int kMaxWarmupFrames = 64;
     /** The scene as it is now (the harness's own copy; animated frames change it). */
     const Scene& scene() const { return m_scene; }
     /** Frames without timestamp queries (to measure the instrumentation's own cost). */

@@ -183,6 +183,10 @@ public:
      *  (e.g. counters) and record them with ctx.stat. Default: nothing. */
     virtual void frameFinished(TechniqueContext& ctx) { (void)ctx; }
     virtual std::vector<DebugView> debugViews() { return {}; }
+    /** False while state the technique carries from frame to frame (ssvp's warm-started
+     *  K-means) still changes on a static scene; FrameHarness::warmUp() renders warm-up frames
+     *  until it is true (docs/timing.md "Warm-up"). Read after frameFinished(). */
+    virtual bool settled() const { return true; }
     /** VPL techniques: the last frame's VPLs as the gather used them (read back after the
      *  frame), for the same-VPL shadow-ray reference. Default: false (not a VPL technique). */
     virtual bool readVplSet(VplSet& out) {

@@ -12,6 +12,33 @@ namespace gilab::vpl {
 
 inline constexpr float kPi = 3.14159265358979323846f;
 
+/** Interleaved subsets of a Hammersley-ordered set (shaders/common/vpl.glsl
+ *  vplInterleaveSubset, which explains the rule). */
+inline uint32_t interleaveBlock(uint32_t n, uint32_t stride) {
+    uint32_t block = 1;
+    while (4ull * block * block * stride <= n)
+        block *= 2;
+    return block;
+}
+inline uint32_t interleaveFold(uint32_t k, uint32_t stride) {
+    if (stride <= 1) return 0;
+    uint32_t bits = 0;
+    while ((1u << bits) < stride)
+        ++bits;
+    uint32_t s = 0;
+    for (; k != 0; k >>= bits)
+        s ^= k & (stride - 1);
+    return s;
+}
+/** mode: 0 fold (power-of-two strides, else blocks), 1 blocks, 2 modulo. */
+inline uint32_t interleaveSubset(uint32_t k, uint32_t n, uint32_t stride, uint32_t rotation,
+                                 uint32_t mode = 0) {
+    if (mode == 0 && stride > 0 && (stride & (stride - 1)) == 0)
+        return interleaveFold(k, stride) ^ (rotation & (stride - 1));
+    if (mode == 2) return (k + rotation) % stride;
+    return (k / interleaveBlock(n, stride) + rotation) % stride;
+}
+
 /** Base-2 radical inverse (Van der Corput) of k. */
 inline float radicalInverse(uint32_t k) {
     k = (k << 16u) | (k >> 16u);

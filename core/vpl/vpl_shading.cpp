@@ -14,7 +14,7 @@ namespace {
 struct GatherPush {  // mirrors vpl_gather.comp
     glm::vec2 bounceScale;
     float clampDistance, biasTexels;
-    uint32_t count, interleave, mapResolution, visibility;
+    uint32_t count, interleave, mapResolution, visibility, firstCount, groupSize, subsets, pad;
 };
 struct BlurPush {  // mirrors vpl_blur.comp
     uint32_t mode;
@@ -28,6 +28,13 @@ uint32_t groupCount(uint32_t w, uint32_t h) {
 }
 
 }  // namespace
+
+InterleaveSubsets interleaveSubsetsFrom(const std::string& name) {
+    if (name == "fold") return InterleaveSubsets::Fold;
+    if (name == "blocks") return InterleaveSubsets::Blocks;
+    if (name == "modulo") return InterleaveSubsets::Modulo;
+    throw Error("interleave subsets '" + name + "': expected fold, blocks or modulo");
+}
 
 VplShading::VplShading(vk::Context& ctx, GBuffer& gbuffer, const vk::Buffer& vpls,
                        const vk::Buffer& clusters, ParaboloidMaps* maps, const std::string& tag)
@@ -104,7 +111,8 @@ void VplShading::bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline,
                             nullptr);
 }
 
-void VplShading::recordGather(VkCommandBuffer cmd, uint32_t count) {
+void VplShading::recordGather(VkCommandBuffer cmd, uint32_t count, uint32_t firstCount,
+                              uint32_t groupSize) {
     if (m_settings.interleave == 0) throw Error("VplShading: interleave must be >= 1");
     bind(cmd, m_gather, m_gatherLayout, m_gatherSet);
     const GatherPush push{m_settings.bounceScale,
@@ -113,7 +121,11 @@ void VplShading::recordGather(VkCommandBuffer cmd, uint32_t count) {
                           count,
                           m_settings.interleave,
                           m_mapResolution,
-                          (m_settings.visibility && m_hasMaps) ? 1u : 0u};
+                          (m_settings.visibility && m_hasMaps) ? 1u : 0u,
+                          firstCount,
+                          groupSize,
+                          uint32_t(m_settings.subsets),
+                          0u};
     m_gatherLayout.push(cmd, push);
     vk::dispatch2D(cmd, m_width, m_height, kGroup, kGroup);
     vk::memoryBarrier(cmd);

@@ -27,8 +27,19 @@ class Context;
 struct GBuffer;
 class ParaboloidMaps;
 
+/** Which VPLs of a Hammersley-ordered set each interleaved sub-image gets
+ *  (shaders/common/vpl.glsl vplInterleaveSubset; docs/vpl.md "Gathering"). */
+enum class InterleaveSubsets : uint32_t {
+    Fold = 0,    // xor of the index's chunks: one VPL of every elementary box to each subset
+    Blocks = 1,  // runs of L consecutive VPLs round-robin
+    Modulo = 2,  // k mod I^2 (one strip of the RSM per subset)
+};
+/** Parses "fold" | "blocks" | "modulo" (throws gilab::Error otherwise). */
+InterleaveSubsets interleaveSubsetsFrom(const std::string& name);
+
 struct VplShadingSettings {
-    uint32_t interleave = 4;            // I: an I x I pattern of VPL subsets (1 = every VPL)
+    uint32_t interleave = 4;  // I: an I x I pattern of VPL subsets (1 = every VPL)
+    InterleaveSubsets subsets = InterleaveSubsets::Blocks;
     float clampDistance = 0.0f;         // d_min in world units; 0 = no clamp
     float visibilityBiasTexels = 1.5f;  // paraboloid test tolerance, map texels at the receiver
     uint32_t blurRadius = 4;            // pixels; 0 = no blur
@@ -57,8 +68,11 @@ public:
 
     void setSettings(const VplShadingSettings& settings) { m_settings = settings; }
     const VplShadingSettings& settings() const { return m_settings; }
-    /** Irradiance from vpls[0 .. count) into irradiance(). */
-    void recordGather(VkCommandBuffer cmd, uint32_t count);
+    /** Irradiance from vpls[0 .. count) into irradiance(). The list is Hammersley-ordered sets
+     *  (each spread over the sub-images on its own): vpls[0 .. firstCount) is one, the rest are
+     *  sets of groupSize (0: the rest is one set). */
+    void recordGather(VkCommandBuffer cmd, uint32_t count, uint32_t firstCount,
+                      uint32_t groupSize = 0);
     /** Blur + albedo into `indirect` (RGBA32F storage image, GENERAL). */
     void recordResolve(VkCommandBuffer cmd, vk::Image& indirect);
     /** The clamp sums of the last gather (valid once its submission has finished). */

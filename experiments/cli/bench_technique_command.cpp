@@ -51,10 +51,14 @@ void benchOne(vk::Context& ctx, const Scene& scene, const std::string& id,
     std::vector<double> frameGpu;
     std::map<std::string, std::vector<double>> passes;
     std::vector<std::string> order;
-    for (int i = 0; i < options.warmupFrames + options.frames; ++i) {
+    const WarmupResult warmup = harness.warmUp(options.warmupFrames, [&](int i) {
+        progress.update(size_t(std::min(i + 1, options.warmupFrames)));
+    });
+    if (!warmup.settled)
+        std::printf("%-8s not settled after %d warm-up frames\n", id.c_str(), warmup.run);
+    for (int i = options.warmupFrames; i < options.warmupFrames + options.frames; ++i) {
         const FrameTiming t = harness.renderFrame();
         progress.update(size_t(i + 1));
-        if (i < options.warmupFrames) continue;
         double sum = 0.0;
         for (const vk::PassTime& p : t.passes) {
             if (!passes.count(p.name)) order.push_back(p.name);

@@ -127,9 +127,11 @@ int runRender(const RenderOptions& options) {
     const int total = options.warmupFrames + options.frames;
     std::vector<FrameTiming> frames;
     Progress frameProgress("frames", size_t(total));
-    for (int i = 0; i < total; ++i) {
-        FrameTiming t = harness->renderFrame();
-        if (i >= options.warmupFrames) frames.push_back(std::move(t));
+    const WarmupResult warmup = harness->warmUp(options.warmupFrames, [&](int i) {
+        frameProgress.update(size_t(std::min(i + 1, options.warmupFrames)));
+    });
+    for (int i = options.warmupFrames; i < total; ++i) {
+        frames.push_back(harness->renderFrame());
         frameProgress.update(size_t(i + 1));
     }
     frameProgress.finish();
@@ -137,7 +139,7 @@ int runRender(const RenderOptions& options) {
     const std::vector<ImageLayer> layers = harness->readLayers();
     size_t nonFinite = 0;
     meta["nonfinite"] = finiteJson(layers, &nonFinite);
-    meta["timing"] = timingJson(setup, frames, options.warmupFrames);
+    meta["timing"] = timingJson(setup, frames, warmup);
     meta["memory"] = memoryJson(harness->memory());
     meta["skipped_passes"] = harness->skipped();
     meta["notes"] = harness->notes();

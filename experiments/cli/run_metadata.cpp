@@ -186,7 +186,7 @@ nlohmann::ordered_json sceneToJson(const Scene& scene) {
 }
 
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
-                                  int warmupFrames) {
+                                  const WarmupResult& warmup) {
     std::vector<double> cpu;
     std::vector<std::string> order;
     std::map<std::string, std::vector<double>> gpu, record;
@@ -226,7 +226,9 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
               {"total", setup.totalMs}}},
             {"setup_gpu_passes", setupPasses},
             {"setup_cpu_passes", setupCpuPasses},
-            {"warmup_frames", warmupFrames},
+            {"warmup_frames", warmup.requested},
+            {"warmup_frames_run", warmup.run},
+            {"warmup_settled", warmup.settled},
             {"timed_frames", frames.size()},
             {"frame_cpu_ms", summaryJson(cpu)},
             {"frame_gpu_ms", summaryJson(gpuTotal)},

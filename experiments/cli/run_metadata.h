@@ -21,9 +21,10 @@ namespace cli {
 nlohmann::ordered_json provenanceJson(const std::string& commandLine);
 nlohmann::ordered_json deviceJson(const vk::Context& ctx);
 nlohmann::ordered_json sceneToJson(const Scene& scene);
-/** Setup times, then per-frame CPU and per-pass GPU times as median / IQR over the frames. */
+/** Setup times, the warm-up, then per-frame CPU and per-pass GPU times as median / IQR over the
+ *  frames. */
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,
-                                  int warmupFrames);
+                                  const WarmupResult& warmup);
 /**
  * The dynamic frames (FrameTiming::dynamic) of an animated run: frame CPU time (update
  * included), frame GPU time (frame passes + update passes), update CPU time, and each update

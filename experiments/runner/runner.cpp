@@ -399,12 +399,15 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                       size_t(c.config.timing.warmupFrames + c.config.timing.timedFrames));
     SetupTiming setup;
     std::vector<FrameTiming> frames;
+    WarmupResult warmup;
     const int total = c.config.timing.warmupFrames + c.config.timing.timedFrames;
     try {
         setup = harness->setup();
-        for (int i = 0; i < total; ++i) {
-            FrameTiming t = harness->renderFrame();
-            if (i >= c.config.timing.warmupFrames) frames.push_back(std::move(t));
+        warmup = harness->warmUp(c.config.timing.warmupFrames, [&](int i) {
+            progress.update(size_t(std::min(i + 1, c.config.timing.warmupFrames)));
+        });
+        for (int i = c.config.timing.warmupFrames; i < total; ++i) {
+            frames.push_back(harness->renderFrame());
             progress.update(size_t(i + 1));
         }
     } catch (const DeviceLimitError& e) {  // valid parameters this device cannot run
@@ -421,7 +424,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
         sameVpl = computeSameVplReference(*harness, harness->scene(), layers, tm);
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
-    result["timing"] = cli::timingJson(setup, frames, c.config.timing.warmupFrames);
+    result["timing"] = cli::timingJson(setup, frames, warmup);
     std::optional<SequenceResult> sequence;
     if (scene.animation.animated()) {
         // Frames 1..N-1 in order after the static frames at frame 0 (docs/experiments.md).

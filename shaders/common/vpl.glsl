@@ -74,4 +74,33 @@ float vplDiskSampleWeight(vec2 p) {
     return 4.0 * max(1.0 - r2, 0.0) / (q * q * q);
 }
 
+// Interleaved shading over a Hammersley-ordered set of n VPLs in stride = I^2 subsets
+// (core/vpl/vpl_math.h mirrors it; docs/vpl.md "Gathering"). Point k's x is k / n (the high
+// bits of k) and its y the radical inverse (the low bits), so subset k mod stride, the usual
+// choice, is one thin strip of y. With stride = 2^t, point k joins subset
+//   fold(k) xor rotation,  fold(k) = the xor of k's t-bit chunks,
+// and any t consecutive bits of k then decide the subset one-to-one: every elementary box of
+// the set holding stride points, of any aspect ratio, has one point of each subset. Other
+// strides: blocks of L consecutive points go round-robin, subset (k / L + rotation) mod stride,
+// L the largest power of two with L^2 stride <= n (L strata of y, n / (L stride) of x).
+uint vplInterleaveBlock(uint n, uint stride) {
+    uint block = 1u;
+    while (4u * block * block * stride <= n) block *= 2u;
+    return block;
+}
+bool vplPowerOfTwo(uint v) { return v > 0u && (v & (v - 1u)) == 0u; }
+uint vplFold(uint k, uint stride) {
+    if (stride <= 1u) return 0u;
+    uint bits = uint(findLSB(stride)), s = 0u;
+    for (; k != 0u; k >>= bits) s ^= k & (stride - 1u);
+    return s;
+}
+// mode (core/vpl/vpl_shading.h InterleaveSubsets): 0 fold (power-of-two strides, else blocks),
+// 1 blocks, 2 modulo (k + rotation) mod stride.
+uint vplInterleaveSubset(uint k, uint n, uint stride, uint rotation, uint mode) {
+    if (mode == 0u && vplPowerOfTwo(stride)) return vplFold(k, stride) ^ (rotation & (stride - 1u));
+    if (mode == 2u) return (k + rotation) % stride;
+    return (k / vplInterleaveBlock(n, stride) + rotation) % stride;
+}
+
 #endif  // GILAB_VPL_GLSL

@@ -33,7 +33,9 @@ layout(push_constant, std430) uniform KmeansPush {
     uint secondVisibility; // 1: second-bounce VPLs take the nearest cluster's map
     uint mapResolution;
     uint eyeAtVpl;         // 1: the map's eye is the member VPL nearest the centroid
-    uint pad0;
+    uint reassign;         // 1: members their map does not see move to a map that does
+    float biasTexels;      // visibility tolerance in map texels (the gather's)
+    uint pad0, pad1;
 } pc;
 
 // Eq. 2 with the position term over the scene diagonal (notes 002 §9). As printed the normal

@@ -70,6 +70,7 @@ SupportResult SsvpTechnique::checkSupport(const Scene& scene, const ParamSet& pa
 
 void SsvpTechnique::setup(TechniqueContext& ctx) {
     m_gpu.reset();
+    m_kmeansConverged = false;
     m_settings = ssvpSettingsFrom(ctx.params);
     const SsvpSettings& s = m_settings;
     std::string why;
@@ -129,6 +130,7 @@ void SsvpTechnique::applySettings(const TechniqueContext& ctx) {
     m_gpu->propagation->setSettings(s, m_gpu->diagonal);
     VplShadingSettings v;
     v.interleave = s.interleave;
+    v.subsets = s.interleaveSubsets;
     v.clampDistance = s.clampDistance * m_gpu->diagonal;
     v.visibilityBiasTexels = s.visibilityBiasTexels;
     v.blurRadius = s.blurRadius;
@@ -178,6 +180,10 @@ void SsvpTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarg
         PassScope pass(ctx, cmd, "paraboloid");
         g.maps->record(cmd);
     }
+    {
+        PassScope pass(ctx, cmd, "misc.map_members");
+        g.propagation->recordMembers(cmd);
+    }
     if (s.bounces >= 2 && s.secondBounceVpls > 0) {
         PassScope pass(ctx, cmd, "misc.second_bounce");
         g.propagation->recordSecondBounce(cmd);
@@ -185,7 +191,8 @@ void SsvpTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarg
     {
         PassScope pass(ctx, cmd, "shade.gather");
         const uint32_t count = s.firstBounceVpls + (s.bounces >= 2 ? s.secondBounceVpls : 0u);
-        g.shading->recordGather(cmd, count);
+        // Sets: the N1 RSM VPLs, then each cluster's M disk VPLs (§III-A, §III-C).
+        g.shading->recordGather(cmd, count, s.firstBounceVpls, std::max(s.perCluster(), 1u));
     }
     PassScope pass(ctx, cmd, "shade.blur");
     g.shading->recordResolve(cmd, targets.indirect);
@@ -200,9 +207,14 @@ void SsvpTechnique::frameFinished(TechniqueContext& ctx) {
     const SsvpKmeansState k = m_gpu->propagation->readState();
     ctx.stat("kmeans_iterations", k.iterations);
     ctx.stat("kmeans_converged", k.converged ? 1.0 : 0.0);
+    m_kmeansConverged = k.converged;
     ctx.stat("kmeans_reseeded", k.reseeded);
     ctx.stat("active_clusters", k.active);
     ctx.stat("valid_first_bounce_vpls", k.assigned);
+    const SsvpMemberStats members = m_gpu->propagation->readMemberStats();
+    ctx.stat("map_sees_member_flux_percent", members.seenPercent);
+    ctx.stat("shading_map_sees_member_flux_percent", members.seenAfterPercent);
+    ctx.stat("moved_member_flux_percent", members.movedPercent);
 }
 
 std::vector<DebugView> SsvpTechnique::debugViews() {

@@ -37,12 +37,15 @@ public:
     void frameFinished(TechniqueContext& ctx) override;
     std::vector<DebugView> debugViews() override;
     bool readVplSet(VplSet& out) override;
+    /** The last frame's K-means converged (a pass changed no assignment). */
+    bool settled() const override { return m_kmeansConverged; }
 
 private:
     void applySettings(const TechniqueContext& ctx);
 
     SsvpSettings m_settings;
     std::unique_ptr<SsvpGpu> m_gpu;
+    bool m_kmeansConverged = false;
 };
 
 }  // namespace gilab

@@ -1,10 +1,14 @@
 #include "techniques/ssvp/ssvp_propagation.h"
 
 #include <algorithm>
+#include <vector>
+
+#include <glm/glm.hpp>
 
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
 #include "core/vpl/paraboloid_maps.h"
+#include "core/vpl/vpl.h"
 
 namespace gilab {
 namespace {
@@ -21,6 +25,9 @@ SsvpPropagation::SsvpPropagation(vk::Context& ctx, const vk::Buffer& vpls,
                          vk::MemoryUsage::Readback, tag + "/kmeans_state");
     const uint32_t zeros[kStateWords] = {};
     m_state.upload(zeros, sizeof(zeros));
+    m_members = vk::Buffer(ctx, VkDeviceSize(vpls.size() / sizeof(GpuVpl)) * 16,
+                           VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::MemoryUsage::Readback,
+                           tag + "/map_members");
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType buf = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType img = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
@@ -30,7 +37,8 @@ SsvpPropagation::SsvpPropagation(vk::Context& ctx, const vk::Buffer& vpls,
                                            {2, buf, 1, cs},
                                            {3, img, 1, cs},
                                            {4, img, 1, cs},
-                                           {5, img, 1, cs}},
+                                           {5, img, 1, cs},
+                                           {6, buf, 1, cs}},
                                           tag + "/propagation");
     m_set = vk::DescriptorSet(ctx, m_setLayout, 0, tag + "/propagation");
     m_set.writeBuffer(0, vpls);
@@ -39,11 +47,14 @@ SsvpPropagation::SsvpPropagation(vk::Context& ctx, const vk::Buffer& vpls,
     m_set.writeStorageImage(3, maps.position().view());
     m_set.writeStorageImage(4, maps.normal().view());
     m_set.writeStorageImage(5, maps.albedo().view());
+    m_set.writeBuffer(6, m_members);
     m_layout = vk::PipelineLayout(ctx, {m_setLayout.handle()}, sizeof(Push));
     m_seed = vk::ComputePipeline(ctx, "ssvp/kmeans_seed.comp", m_layout);
     m_assign = vk::ComputePipeline(ctx, "ssvp/kmeans_assign.comp", m_layout);
     m_update = vk::ComputePipeline(ctx, "ssvp/kmeans_update.comp", m_layout);
     m_second = vk::ComputePipeline(ctx, "ssvp/second_bounce.comp", m_layout);
+    m_memberTest = vk::ComputePipeline(ctx, "ssvp/map_members.comp", m_layout);
+    m_clusterFlux = vk::ComputePipeline(ctx, "ssvp/cluster_flux.comp", m_layout);
     m_push.mapResolution = maps.settings().resolution;
 }
 
@@ -63,6 +74,8 @@ void SsvpPropagation::setSettings(const SsvpSettings& s, float sceneDiagonal) {
     m_push.paperWeights = s.paperWeights ? 1u : 0u;
     m_push.secondVisibility = s.secondBounceVisibility ? 1u : 0u;
     m_push.eyeAtVpl = s.eyeAtNearestVpl ? 1u : 0u;
+    m_push.reassign = s.reassignMembers ? 1u : 0u;
+    m_push.biasTexels = s.visibilityBiasTexels;
 }
 
 void SsvpPropagation::bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline) {
@@ -96,12 +109,45 @@ void SsvpPropagation::recordClustering(VkCommandBuffer cmd) {
     vk::hostReadBarrier(cmd);
 }
 
+void SsvpPropagation::recordMembers(VkCommandBuffer cmd) {
+    bind(cmd, m_memberTest);
+    m_layout.push(cmd, m_push);
+    vk::dispatch1D(cmd, m_push.count, 64);
+    vk::memoryBarrier(cmd);
+    if (m_push.reassign != 0u) {
+        bind(cmd, m_clusterFlux);
+        m_layout.push(cmd, m_push);
+        vkCmdDispatch(cmd, 1, 1, 1);
+        vk::memoryBarrier(cmd);
+    }
+    vk::hostReadBarrier(cmd);
+}
+
 void SsvpPropagation::recordSecondBounce(VkCommandBuffer cmd) {
     if (m_push.secondCount == 0) return;
     bind(cmd, m_second);
     m_layout.push(cmd, m_push);
     vk::dispatch1D(cmd, m_push.secondCount, 64);
     vk::memoryBarrier(cmd);
+}
+
+SsvpMemberStats SsvpPropagation::readMemberStats() {
+    std::vector<glm::vec4> m(m_push.count);
+    m_members.download(m.data(), VkDeviceSize(m.size()) * 16);
+    double flux = 0.0, seen = 0.0, after = 0.0, moved = 0.0;
+    for (const glm::vec4& v : m) {
+        flux += v.x;
+        seen += v.x * v.y;
+        after += v.x * v.z;
+        moved += v.x * v.w;
+    }
+    SsvpMemberStats s;
+    if (flux > 0.0) {
+        s.seenPercent = 100.0 * seen / flux;
+        s.seenAfterPercent = 100.0 * after / flux;
+        s.movedPercent = 100.0 * moved / flux;
+    }
+    return s;
 }
 
 SsvpKmeansState SsvpPropagation::readState() {

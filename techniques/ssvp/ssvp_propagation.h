@@ -5,6 +5,9 @@
  *                         iteration an assignment dispatch and an update dispatch
  *                         (shaders/ssvp/kmeans_*.comp), warm-started from the previous frame's
  *                         centroids, stopping on convergence or after the iteration cap
+ *   recordMembers         after the maps: does each cluster's map see its members
+ *                         (map_members.comp; with map_members = reassign, unseen members move to
+ *                         a map that sees them and cluster_flux.comp re-sums the fluxes)
  *   recordSecondBounce    N2 / C VPLs per cluster from its paraboloid map (second_bounce.comp)
  * readState() gives the last frame's iteration count and re-seeded clusters once it finished.
  */
@@ -32,6 +35,13 @@ struct SsvpKmeansState {
     uint32_t assigned = 0;  // valid first-bounce VPLs in them
 };
 
+/** What map_members.comp found in the last frame (shares of the clustered members' flux). */
+struct SsvpMemberStats {
+    double seenPercent = 0.0;       // seen by their own cluster's map
+    double seenAfterPercent = 0.0;  // seen by the map they are shaded with (after a move)
+    double movedPercent = 0.0;      // moved to another cluster (map_members = reassign)
+};
+
 class SsvpPropagation {
 public:
     SsvpPropagation(vk::Context& ctx, const vk::Buffer& vpls, const vk::Buffer& clusters,
@@ -42,24 +52,28 @@ public:
     /** sceneDiagonal: the unit of the position term of Eq. 2 and of the eye offset. */
     void setSettings(const SsvpSettings& settings, float sceneDiagonal);
     void recordClustering(VkCommandBuffer cmd);
+    void recordMembers(VkCommandBuffer cmd);
     void recordSecondBounce(VkCommandBuffer cmd);
     SsvpKmeansState readState();
+    SsvpMemberStats readMemberStats();
 
 private:
     struct Push {  // mirrors KmeansPush in shaders/ssvp/kmeans_common.glsl
         float positionWeight, normalWeight, invDiagonal, eyeOffset;
         uint32_t count, clusterCount, iteration, metric, seed, secondCount, perCluster,
-            paperWeights, secondVisibility, mapResolution, eyeAtVpl, pad0;
+            paperWeights, secondVisibility, mapResolution, eyeAtVpl, reassign;
+        float biasTexels;
+        uint32_t pad0, pad1;
     };
     void bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline);
 
     SsvpSettings m_settings;
     Push m_push{};
-    vk::Buffer m_state;
+    vk::Buffer m_state, m_members;
     vk::DescriptorSetLayout m_setLayout;
     vk::DescriptorSet m_set;
     vk::PipelineLayout m_layout;
-    vk::ComputePipeline m_seed, m_assign, m_update, m_second;
+    vk::ComputePipeline m_seed, m_assign, m_update, m_second, m_memberTest, m_clusterFlux;
 };
 
 }  // namespace gilab

@@ -52,6 +52,11 @@ std::vector<ParamSpec> ssvpParamSpecs() {
                   "to it (never inside geometry or in the air)"),
         intParam("interleave", 4, 1, 16, "pixels",
                  "interleaved shading pattern I x I (paper 4; authors' code 2)"),
+        enumParam("interleave_subsets", "blocks", {"blocks", "fold", "modulo"},
+                  "which VPLs each sub-image gets: blocks (runs of L consecutive VPLs, an L x "
+                  "n/(L I^2) grid of the RSM each) | fold (xor of index chunks: every RSM box of "
+                  "I^2 VPLs gives one to each) | modulo (VPL k mod I^2: one strip of the RSM "
+                  "each, the version before issue 29)"),
         intParam("blur_radius", 4, 0, 16, "pixels",
                  "edge-aware Gaussian radius, sigma = radius / 2 (0 = no blur; not given)"),
         floatParam("clamp_distance", 0.01, 0.0, 1.0, "scene diagonals",
@@ -61,6 +66,9 @@ std::vector<ParamSpec> ssvpParamSpecs() {
         enumParam("weights", "physical", {"physical", "paper"},
                   "physical: flux per VPL from its sampling density, 1/N per bounce | paper: "
                   "Eq. 6 equal weights over N1 + N2 (not energy-consistent)"),
+        enumParam("map_members", "keep", {"keep", "reassign"},
+                  "first-bounce VPLs their cluster's map does not see: keep (the paper) | "
+                  "reassign to the nearest map that sees them, cluster fluxes re-summed (ours)"),
         enumParam("second_bounce_visibility", "none", {"none", "cluster"},
                   "second-bounce VPLs unshadowed (the paper as read) | tested against the "
                   "nearest cluster's map"),
@@ -86,11 +94,13 @@ SsvpSettings ssvpSettingsFrom(const ParamSet& p) {
     s.centroidOffset = float(p.getFloat("centroid_offset"));
     s.eyeAtNearestVpl = p.getEnum("map_eye") == "nearest_vpl";
     s.interleave = uint32_t(p.getInt("interleave"));
+    s.interleaveSubsets = interleaveSubsetsFrom(p.getEnum("interleave_subsets"));
     s.blurRadius = uint32_t(p.getInt("blur_radius"));
     s.clampDistance = float(p.getFloat("clamp_distance"));
     s.visibilityBiasTexels = float(p.getFloat("visibility_bias_texels"));
     s.paperWeights = p.getEnum("weights") == "paper";
     s.secondBounceVisibility = p.getEnum("second_bounce_visibility") == "cluster";
+    s.reassignMembers = p.getEnum("map_members") == "reassign";
     if (s.secondBounceVpls % s.clusters != 0) {
         throw Error("ssvp: second_bounce_vpls = " + std::to_string(s.secondBounceVpls) +
                     " must be a multiple of clusters = " + std::to_string(s.clusters) +

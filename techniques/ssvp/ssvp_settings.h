@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "core/params/params.h"
+#include "core/vpl/vpl_shading.h"
 
 namespace gilab {
 
@@ -31,11 +32,13 @@ struct SsvpSettings {
     float centroidOffset = 0.001f;  // x scene diagonal
     bool eyeAtNearestVpl = false;   // map_eye = nearest_vpl
     uint32_t interleave = 4;
+    InterleaveSubsets interleaveSubsets = InterleaveSubsets::Blocks;
     uint32_t blurRadius = 4;
     float clampDistance = 0.01f;  // x scene diagonal; 0 = no clamp
     float visibilityBiasTexels = 1.5f;
     bool paperWeights = false;
     bool secondBounceVisibility = false;
+    bool reassignMembers = false;  // map_members = reassign (ours, issue 29)
 
     uint32_t perCluster() const { return clusters > 0 ? secondBounceVpls / clusters : 0; }
 };
