@@ -70,11 +70,11 @@ def per_bounce(rows):
     for r in rows:
         p = r["technique"]["params"]
         if p["bounces"] == 1:
-            ones[(r["scene"]["label"], key_without(p, "bounces"))] = r
+            ones[(r["scene"]["label"], key_without(p, ("bounces",) + SECOND_BOUNCE_ONLY))] = r
     out = []
     for r in rows:
         p = r["technique"]["params"]
-        one = ones.get((r["scene"]["label"], key_without(p, "bounces")))
+        one = ones.get((r["scene"]["label"], key_without(p, ("bounces",) + SECOND_BOUNCE_ONLY)))
         if p["bounces"] != 2 or one is None:
             continue
         lad = r["metrics"].get("final_vs_bounces", {})
@@ -104,13 +104,25 @@ def variant(params):
         tags.append(f"I={params['interleave']}")
     if params.get("interleave_subsets", "blocks") != "blocks":
         tags.append(params["interleave_subsets"])
+    if params.get("map_eye", "centroid") != "centroid":
+        tags.append(params["map_eye"])
     if params.get("map_members", "keep") != "keep":
         tags.append(params["map_members"])
+    if params.get("bounces", 2) == 2 and params.get("second_bounce_visibility", "none") != "none":
+        tag = params["second_bounce_visibility"]
+        if tag == "own_maps":
+            tag += f"(C2={params.get('second_bounce_clusters', 8)})"
+        tags.append(tag)
     return ",".join(tags) or "-"
 
 
+# Parameters a bounces = 1 run does not use: its twin of a two-bounce run may differ in them.
+SECOND_BOUNCE_ONLY = ("second_bounce_vpls", "second_bounce_visibility", "second_bounce_clusters")
+
+
 def key_without(params, drop):
-    return tuple(sorted((k, str(v)) for k, v in params.items() if k != drop))
+    drop = (drop,) if isinstance(drop, str) else drop
+    return tuple(sorted((k, str(v)) for k, v in params.items() if k not in drop))
 
 
 def relative(rows, folder, gilab):
@@ -135,11 +147,12 @@ def relative(rows, folder, gilab):
             m = json.loads(out)["metrics"]
         except (OSError, subprocess.CalledProcessError, json.JSONDecodeError) as e:
             lines.append(f"{r['scene']['label']}\t{p['clusters']}\t{p['second_bounce_vpls']}\t"
-                         f"compare failed: {e}")
+                         f"{p['bounces']}\tcompare failed: {e}")
             continue
         flip = m.get("flip") or {}
         lines.append("\t".join([r["scene"]["label"], str(p["clusters"]),
-                                str(p["second_bounce_vpls"]), fmt(m.get("rel_mse"), 4),
+                                str(p["second_bounce_vpls"]), str(p["bounces"]),
+                                fmt(m.get("rel_mse"), 4),
                                 fmt(flip.get("mean") if isinstance(flip, dict) else flip, 4)]))
     return lines
 
@@ -225,7 +238,7 @@ def main(folder, gilab):
     if lines:
         print("\nRelative to C = 32 (the paper's Fig. 6 comparison; paper HDR-VDP-2 RMSE: "
               "C = 4 0.1259, 8 0.1020, 16 0.0806)")
-        print("\t".join(["scene", "C", "N2", "relMSE_vs_C32", "HDR-FLIP_vs_C32"]))
+        print("\t".join(["scene", "C", "N2", "bounces", "relMSE_vs_C32", "HDR-FLIP_vs_C32"]))
         for line in lines:
             print(line)
 

@@ -1,6 +1,7 @@
 #include "core/vpl/paraboloid_maps.h"
 
 #include <algorithm>
+#include <optional>
 
 #include "core/gpu/gpu_scene.h"
 #include "core/util/error.h"
@@ -79,21 +80,26 @@ void ParaboloidMaps::setSubdivision(uint32_t maxSubdivision, float maxEdgeAngleR
     m_settings.maxEdgeAngleRad = maxEdgeAngleRad;
 }
 
-void ParaboloidMaps::record(VkCommandBuffer cmd) {
+void ParaboloidMaps::record(VkCommandBuffer cmd, uint32_t first, uint32_t count) {
+    first = std::min(first, m_settings.layers);
+    count = std::min(count, m_settings.layers - first);
     for (vk::Image* img : {&m_position, &m_normal, &m_albedo})
         img->transition(cmd, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL);
     m_depth.transition(cmd, VK_IMAGE_LAYOUT_DEPTH_ATTACHMENT_OPTIMAL);
     {
-        const VkClearColorValue zero{{0.0f, 0.0f, 0.0f, 0.0f}};
+        // Layers below `first` are loaded unchanged (nothing is drawn into them); the depth is
+        // cleared every time, as only the drawn layers use it.
+        std::optional<VkClearColorValue> clear;
+        if (first == 0) clear = VkClearColorValue{{0.0f, 0.0f, 0.0f, 0.0f}};
         vk::DepthTarget depth;
         depth.view = m_depth.view();
         depth.clear = 1.0f;
         depth.store = false;
         vk::RenderingScope scope(
             cmd, m_position.extent2D(),
-            {{m_position.view(), zero}, {m_normal.view(), zero}, {m_albedo.view(), zero}}, depth,
+            {{m_position.view(), clear}, {m_normal.view(), clear}, {m_albedo.view(), clear}}, depth,
             m_settings.layers);
-        if (m_scene.triangleCount() > 0) {
+        if (m_scene.triangleCount() > 0 && count > 0) {
             m_pipeline.bind(cmd);
             VkDescriptorSet sets[2] = {m_scene.set().handle(), m_set.handle()};
             vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_GRAPHICS, m_layout.handle(), 0, 2,
@@ -101,7 +107,8 @@ void ParaboloidMaps::record(VkCommandBuffer cmd) {
             const ParaboloidPush push{m_settings.far, m_settings.maxEdgeAngleRad,
                                       m_settings.maxSubdivision, m_settings.resolution};
             m_layout.push(cmd, push);
-            vkCmdDraw(cmd, 3 * m_scene.triangleCount(), m_settings.layers, 0, 0);
+            // Instance i draws layer i (paraboloid.vert): firstInstance picks the range.
+            vkCmdDraw(cmd, 3 * m_scene.triangleCount(), count, 0, first);
         }
     }
     for (vk::Image* img : {&m_position, &m_normal, &m_albedo})

@@ -43,7 +43,13 @@ public:
     /** The per-frame triangle split rule (paraboloid.geom). */
     void setSubdivision(uint32_t maxSubdivision, float maxEdgeAngleRad);
     /** Clears and renders every layer (one instanced, layered draw of the scene). */
-    void record(VkCommandBuffer cmd);
+    void record(VkCommandBuffer cmd) { record(cmd, 0, m_settings.layers); }
+    /**
+     * Renders layers [first, first + count) only. first = 0 clears every layer first; a later
+     * range keeps the layers below it as rendered (ssvp's second-bounce maps, drawn after the
+     * first-bounce ones are read).
+     */
+    void record(VkCommandBuffer cmd, uint32_t first, uint32_t count);
 
     vk::Image& position() { return m_position; }
     vk::Image& normal() { return m_normal; }

@@ -10,14 +10,17 @@ layout(local_size_x = 64) in;
 
 void main() {
     uint j = gl_LocalInvocationID.x;
-    if (j >= pc.clusterCount || clusters[j].position.w < 0.5) return;
+    if (j >= pc.clusterCount) return;
+    uint cj = clusterAt(j);
+    if (clusters[cj].position.w < 0.5) return;
     vec3 sum = vec3(0.0);
     uint members = 0u;
     for (uint i = 0u; i < pc.count; ++i) {
-        if (int(vpls[i].normal.w) != int(j)) continue;
-        sum += vpls[i].flux.rgb;
+        Vpl v = vpls[vplAt(i)];
+        if (int(v.normal.w) != int(cj)) continue;
+        sum += v.flux.rgb;
         ++members;
     }
-    clusters[j].flux = vec4(sum, 0.0);
-    clusters[j].normal.w = float(members);
+    clusters[cj].flux = vec4(sum, 0.0);
+    clusters[cj].normal.w = float(members);
 }

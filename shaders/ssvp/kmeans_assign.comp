@@ -10,20 +10,22 @@ layout(local_size_x = 64) in;
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.count || state.converged != 0u) return;
-    int old = int(vpls[i].normal.w);
+    uint vi = vplAt(i);
+    int old = int(vpls[vi].normal.w);
     int best = -1;
     if (vplValid(i)) {
         float bestDistance = 3.0e38;
         for (uint j = 0u; j < pc.clusterCount; ++j) {
             if (!clusterSeeded(j)) continue;
-            float d = kmeansDistance(vpls[i].position.xyz, vpls[i].normal.xyz, clusters[j].mean.xyz,
-                                     clusters[j].normal.xyz);
+            uint cj = clusterAt(j);
+            float d = kmeansDistance(vpls[vi].position.xyz, vpls[vi].normal.xyz,
+                                     clusters[cj].mean.xyz, clusters[cj].normal.xyz);
             if (d < bestDistance) {
                 bestDistance = d;
-                best = int(j);
+                best = int(cj);
             }
         }
     }
     if (best != old) atomicAdd(state.changed, 1u);
-    vpls[i].normal.w = float(best);
+    vpls[vi].normal.w = float(best);
 }

@@ -1,5 +1,8 @@
-// K-means over the first-bounce VPLs (techniques/ssvp/ssvp_kmeans.h; Aranha et al. §III-B).
-// Bindings and push constants shared by kmeans_seed/assign/update.comp and second_bounce.comp.
+// K-means over a range of VPLs (techniques/ssvp/ssvp_propagation.h; Aranha et al. §III-B): the
+// first-bounce VPLs into clusters [0, C), or, with second_bounce_visibility = own_maps (ours), the
+// second-bounce VPLs into clusters [C, C + C2). A VPL's normal.w holds its cluster's global index
+// (= its paraboloid map layer). Bindings and push constants shared by kmeans_seed/assign/update,
+// map_members, cluster_flux and second_bounce.comp.
 #ifndef GILAB_SSVP_KMEANS_GLSL
 #define GILAB_SSVP_KMEANS_GLSL
 #include "common/vpl.glsl"
@@ -22,21 +25,26 @@ layout(push_constant, std430) uniform KmeansPush {
     float normalWeight;    // w2
     float invDiagonal;     // positions are compared in units of the scene diagonal
     float eyeOffset;       // map eye = centroid + offset x normal (world units)
-    uint count;            // first-bounce VPLs
-    uint clusterCount;     // C
+    uint count;            // VPLs clustered (from vplBase)
+    uint clusterCount;     // clusters (from clusterBase)
     uint iteration;        // this pass's iteration (0-based)
     uint metric;           // 0 corrected: w2 (1 - (n_i.n_j)+); 1 literal: w2 (n_i.n_j)+
     uint seed;             // first-frame seeding
-    uint secondCount;      // second-bounce VPLs (second_bounce.comp)
+    uint secondCount;      // second-bounce VPLs (second_bounce.comp; first-bounce range only)
     uint perCluster;       // second-bounce VPLs per cluster M = N2 / C
     uint paperWeights;     // 1: Eq. 6's constant phi (weights = paper)
-    uint secondVisibility; // 1: second-bounce VPLs take the nearest cluster's map
+    uint secondVisibility; // 1: second-bounce VPLs take the nearest first-bounce cluster's map
     uint mapResolution;
     uint eyeAtVpl;         // 1: the map's eye is the member VPL nearest the centroid
     uint reassign;         // 1: members their map does not see move to a map that does
     float biasTexels;      // visibility tolerance in map texels (the gather's)
-    uint pad0, pad1;
+    uint vplBase;          // first VPL of the clustered range (0, or N1 for the second bounce)
+    uint clusterBase;      // first cluster of the range (0, or C for the second bounce)
 } pc;
+
+// Global indices of the range's VPL i and cluster j.
+uint vplAt(uint i) { return pc.vplBase + i; }
+uint clusterAt(uint j) { return pc.clusterBase + j; }
 
 // Eq. 2 with the position term over the scene diagonal (notes 002 §9). As printed the normal
 // term rewards dissimilar normals; the corrected form uses the dissimilarity 1 - (n_i.n_j)+.
@@ -47,7 +55,7 @@ float kmeansDistance(vec3 p, vec3 n, vec3 center, vec3 centerNormal) {
            pc.normalWeight * normalTerm;
 }
 
-bool vplValid(uint i) { return vpls[i].position.w > 0.5; }
-bool clusterSeeded(uint j) { return clusters[j].mean.w > 0.5; }
+bool vplValid(uint i) { return vpls[vplAt(i)].position.w > 0.5; }
+bool clusterSeeded(uint j) { return clusters[clusterAt(j)].mean.w > 0.5; }
 
 #endif  // GILAB_SSVP_KMEANS_GLSL

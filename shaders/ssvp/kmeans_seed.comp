@@ -22,7 +22,8 @@ void main() {
     if (valid == 0u) return;  // nothing lit yet: try again next frame
     uint taken[64];
     for (uint j = 0u; j < pc.clusterCount; ++j) {
-        clusters[j] = VplCluster(vec4(0.0), vec4(0.0, 0.0, 1.0, 0.0), vec4(0.0), vec4(0.0));
+        uint cj = clusterAt(j);
+        clusters[cj] = VplCluster(vec4(0.0), vec4(0.0, 0.0, 1.0, 0.0), vec4(0.0), vec4(0.0));
         if (j >= valid) continue;
         uint start = pcgHash(pc.seed * 9781u + j * 6271u + 1u) % pc.count;
         for (uint t = 0u; t < pc.count; ++t) {
@@ -33,8 +34,8 @@ void main() {
                 used = used || taken[k] == i;
             if (used) continue;
             taken[j] = i;
-            clusters[j].mean = vec4(vpls[i].position.xyz, 1.0);
-            clusters[j].normal = vec4(vpls[i].normal.xyz, 0.0);
+            clusters[cj].mean = vec4(vpls[vplAt(i)].position.xyz, 1.0);
+            clusters[cj].normal = vec4(vpls[vplAt(i)].normal.xyz, 0.0);
             break;
         }
     }

@@ -25,14 +25,16 @@ void main() {
         if (j == 0u) state.converged = 1u;
         return;
     }
+    uint cj = clusterAt(j);
     vec3 sumP = vec3(0.0), sumN = vec3(0.0), sumF = vec3(0.0);
     uint members = 0u;
     if (j < pc.clusterCount) {
         for (uint i = 0u; i < pc.count; ++i) {
-            if (int(vpls[i].normal.w) != int(j)) continue;
-            sumP += vpls[i].position.xyz;
-            sumN += vpls[i].normal.xyz;
-            sumF += vpls[i].flux.rgb;
+            Vpl v = vpls[vplAt(i)];
+            if (int(v.normal.w) != int(cj)) continue;
+            sumP += v.position.xyz;
+            sumN += v.normal.xyz;
+            sumF += v.flux.rgb;
             ++members;
         }
     }
@@ -41,10 +43,10 @@ void main() {
     if (j < pc.clusterCount && members > 0u) {
         vec3 mean = sumP / float(members);
         float len = length(sumN);
-        vec3 n = len > 1e-3 * float(members) ? sumN / len : clusters[j].normal.xyz;
+        vec3 n = len > 1e-3 * float(members) ? sumN / len : clusters[cj].normal.xyz;
         if (!(dot(n, n) > 0.5)) n = vec3(0.0, 0.0, 1.0);
-        clusters[j].mean = vec4(mean, 1.0);
-        clusters[j].normal = vec4(n, float(members));
+        clusters[cj].mean = vec4(mean, 1.0);
+        clusters[cj].normal = vec4(n, float(members));
         vec3 eye = mean;
         vec3 eyeNormal = n;
         if (pc.eyeAtVpl != 0u) {
@@ -52,17 +54,18 @@ void main() {
             // the eye is on a lit surface, never inside an object or floating (notes 002 §6).
             float best = 3.0e38;
             for (uint i = 0u; i < pc.count; ++i) {
-                if (int(vpls[i].normal.w) != int(j)) continue;
-                float d = dot(vpls[i].position.xyz - mean, vpls[i].position.xyz - mean);
+                Vpl v = vpls[vplAt(i)];
+                if (int(v.normal.w) != int(cj)) continue;
+                float d = dot(v.position.xyz - mean, v.position.xyz - mean);
                 if (d < best) {
                     best = d;
-                    eye = vpls[i].position.xyz;
-                    eyeNormal = vpls[i].normal.xyz;
+                    eye = v.position.xyz;
+                    eyeNormal = v.normal.xyz;
                 }
             }
         }
-        clusters[j].position = vec4(eye + pc.eyeOffset * eyeNormal, 1.0);
-        clusters[j].flux = vec4(sumF, 0.0);
+        clusters[cj].position = vec4(eye + pc.eyeOffset * eyeNormal, 1.0);
+        clusters[cj].flux = vec4(sumF, 0.0);
     }
     barrier();
     if (j == 0u) {
@@ -76,20 +79,22 @@ void main() {
         state.assigned = assigned;
         for (uint c = 0u; c < pc.clusterCount; ++c) {
             if (sMembers[c] > 0u) continue;
-            clusters[c].position.w = 0.0;
-            clusters[c].normal.w = 0.0;
-            clusters[c].flux = vec4(0.0);
+            uint cc = clusterAt(c);
+            clusters[cc].position.w = 0.0;
+            clusters[cc].normal.w = 0.0;
+            clusters[cc].flux = vec4(0.0);
             int far = -1;
             float farDistance = -1.0;
             for (uint i = 0u; i < pc.count; ++i) {
-                int own = int(vpls[i].normal.w);
+                Vpl v = vpls[vplAt(i)];
+                int own = int(v.normal.w);
                 if (!vplValid(i) || own < 0) continue;
                 bool used = false;
                 for (uint k = 0u; k < taken; ++k)
                     used = used || sTaken[k] == i;
                 if (used) continue;
-                float d = kmeansDistance(vpls[i].position.xyz, vpls[i].normal.xyz,
-                                         clusters[own].mean.xyz, clusters[own].normal.xyz);
+                float d = kmeansDistance(v.position.xyz, v.normal.xyz, clusters[own].mean.xyz,
+                                         clusters[own].normal.xyz);
                 if (d > farDistance) {
                     farDistance = d;
                     far = int(i);
@@ -97,9 +102,10 @@ void main() {
             }
             if (far < 0) continue;  // no VPL left: stays unseeded or keeps its old centroid
             sTaken[taken++] = uint(far);
-            clusters[c].mean = vec4(vpls[far].position.xyz, 1.0);
-            clusters[c].normal = vec4(vpls[far].normal.xyz, 0.0);
-            clusters[c].position = vec4(vpls[far].position.xyz, 0.0);
+            Vpl f = vpls[vplAt(uint(far))];
+            clusters[cc].mean = vec4(f.position.xyz, 1.0);
+            clusters[cc].normal = vec4(f.normal.xyz, 0.0);
+            clusters[cc].position = vec4(f.position.xyz, 0.0);
             state.reseeded += 1u;
         }
         state.iterations += 1u;

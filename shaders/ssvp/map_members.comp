@@ -2,8 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // Does a cluster's paraboloid map see its own members? (issue 29; ours, not in the paper.)
 // Clustered visibility shades receiver x from VPL i as if from the map's eye, so a member the eye
-// does not see is a VPL whose light the gather places wrongly. Per first-bounce VPL i, after the
-// maps: members[i] = (flux, seen by its own map, seen after the move, moved). With
+// does not see is a VPL whose light the gather places wrongly. Per clustered VPL i (global
+// index), after the maps: members[i] = (flux, seen by its own map, seen after the move, moved). With
 // map_members = reassign, a member its map does not see joins the active cluster whose map sees
 // it with the nearest eye (none: it stays); cluster_flux.comp then re-sums the clusters' flux.
 #include "ssvp/kmeans_common.glsl"
@@ -17,10 +17,11 @@ layout(set = 0, binding = 6, std430) writeonly buffer Members { vec4 members[]; 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= pc.count) return;
-    Vpl v = vpls[i];
+    uint vi = vplAt(i);
+    Vpl v = vpls[vi];
     int own = int(v.normal.w);
     if (!vplValid(i) || own < 0) {
-        members[i] = vec4(0.0);
+        members[vi] = vec4(0.0);
         return;
     }
     float flux = dot(v.flux.rgb, vec3(1.0 / 3.0));
@@ -32,7 +33,8 @@ void main() {
     int chosen = own;
     if (seen == 0.0 && pc.reassign != 0u) {
         float best = 3.0e38;
-        for (uint c = 0u; c < pc.clusterCount; ++c) {
+        for (uint j = 0u; j < pc.clusterCount; ++j) {
+            uint c = clusterAt(j);
             if (int(c) == own || clusters[c].position.w < 0.5) continue;
             vec3 d = v.position.xyz - clusters[c].position.xyz;
             if (dot(d, d) >= best) continue;
@@ -41,7 +43,7 @@ void main() {
             best = dot(d, d);
             chosen = int(c);
         }
-        vpls[i].normal.w = float(chosen);
+        vpls[vi].normal.w = float(chosen);
     }
-    members[i] = vec4(flux, seen, chosen != own ? 1.0 : seen, chosen != own ? 1.0 : 0.0);
+    members[vi] = vec4(flux, seen, chosen != own ? 1.0 : seen, chosen != own ? 1.0 : 0.0);
 }

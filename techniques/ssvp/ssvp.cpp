@@ -86,7 +86,7 @@ void SsvpTechnique::setup(TechniqueContext& ctx) {
     const uint32_t total = s.firstBounceVpls + s.secondBounceVpls;
     gpu->vpls = vk::Buffer(ctx.vk, VkDeviceSize(total) * sizeof(GpuVpl), storage,
                            vk::MemoryUsage::DeviceLocal, ctx.tag("vpls"));
-    gpu->clusters = vk::Buffer(ctx.vk, VkDeviceSize(s.clusters) * sizeof(GpuVplCluster), storage,
+    gpu->clusters = vk::Buffer(ctx.vk, VkDeviceSize(s.mapLayers()) * sizeof(GpuVplCluster), storage,
                                vk::MemoryUsage::DeviceLocal, ctx.tag("clusters"));
     ctx.vk.submitAndWait([&](VkCommandBuffer cmd) {
         vkCmdFillBuffer(cmd, gpu->vpls.handle(), 0, VK_WHOLE_SIZE, 0);
@@ -97,7 +97,7 @@ void SsvpTechnique::setup(TechniqueContext& ctx) {
                                                      s.rsmResolution, ctx.tag("gi"));
     ParaboloidSettings ps;
     ps.resolution = s.paraboloidResolution;
-    ps.layers = s.clusters;
+    ps.layers = s.mapLayers();
     ps.far = 2.0f * gpu->diagonal;
     gpu->maps =
         std::make_unique<ParaboloidMaps>(ctx.vk, ctx.gpuScene, gpu->clusters, ps, ctx.tag("gi"));
@@ -113,12 +113,19 @@ void SsvpTechnique::setup(TechniqueContext& ctx) {
              (l.type == LightType::Spot ? "spot" : "directional") + "): RSM " +
              std::to_string(s.rsmResolution) + "^2, " + std::to_string(s.clusters) +
              " paraboloid maps of " + std::to_string(s.paraboloidResolution) + "^2");
+    if (s.ownMapClusters() > 0)
+        ctx.note(
+            "second_bounce_visibility = own_maps (ours): " + std::to_string(s.ownMapClusters()) +
+            " more paraboloid maps for the second-bounce VPLs");
     if (ctx.scene.lights.size() > 1)
         ctx.skip("bounce from other lights",
                  "the method bounces one main light (§III-A); the others are direct only");
     if (ctx.scene.caps.emissiveTriangleCount > 0)
         ctx.skip("bounce from emissive surfaces", "not a light of the method");
     if (s.bounces < 2) ctx.skip("misc.second_bounce", "bounces = 1: first-bounce VPLs only");
+    if (s.ownMapClusters() == 0)
+        ctx.skip("paraboloid.second_bounce",
+                 "second_bounce_visibility is not own_maps: no maps for second-bounce VPLs");
     ctx.stat("memory_mib",
              double(m_gpu->maps->bytes() + m_gpu->vpls.size() + m_gpu->clusters.size()) /
                  (1024.0 * 1024.0));
@@ -134,7 +141,7 @@ void SsvpTechnique::applySettings(const TechniqueContext& ctx) {
     v.clampDistance = s.clampDistance * m_gpu->diagonal;
     v.visibilityBiasTexels = s.visibilityBiasTexels;
     v.blurRadius = s.blurRadius;
-    const uint32_t second = s.bounces >= 2 ? s.secondBounceVpls : 0u;
+    const uint32_t second = s.secondCount();
     // weights = paper: Eq. 6's 1/N over N = N1 + N2 for both bounces (the first-bounce flux is
     // already E A / N1 per VPL, so it is scaled by N1 / N; docs/techniques/ssvp.md).
     const float paper = float(s.firstBounceVpls) / float(s.firstBounceVpls + second);
@@ -174,23 +181,37 @@ void SsvpTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarg
     }
     {
         PassScope pass(ctx, cmd, "misc.kmeans");
-        g.propagation->recordClustering(cmd);
+        g.propagation->recordClustering(cmd, SsvpRange::First);
     }
     {
-        PassScope pass(ctx, cmd, "paraboloid");
-        g.maps->record(cmd);
+        PassScope pass(ctx, cmd, "paraboloid.maps");
+        g.maps->record(cmd, 0, s.clusters);
     }
     {
         PassScope pass(ctx, cmd, "misc.map_members");
-        g.propagation->recordMembers(cmd);
+        g.propagation->recordMembers(cmd, SsvpRange::First);
     }
-    if (s.bounces >= 2 && s.secondBounceVpls > 0) {
+    if (s.secondCount() > 0) {
         PassScope pass(ctx, cmd, "misc.second_bounce");
         g.propagation->recordSecondBounce(cmd);
     }
+    if (s.ownMapClusters() > 0) {
+        // own_maps (ours): the second-bounce VPLs get clusters and maps of their own, so the
+        // gather tests them as it tests the first bounce (layers C .. C + C2).
+        {
+            PassScope pass(ctx, cmd, "misc.second_kmeans");
+            g.propagation->recordClustering(cmd, SsvpRange::Second);
+        }
+        {
+            PassScope pass(ctx, cmd, "paraboloid.second_bounce");
+            g.maps->record(cmd, s.clusters, s.ownMapClusters());
+        }
+        PassScope pass(ctx, cmd, "misc.second_map_members");
+        g.propagation->recordMembers(cmd, SsvpRange::Second);
+    }
     {
         PassScope pass(ctx, cmd, "shade.gather");
-        const uint32_t count = s.firstBounceVpls + (s.bounces >= 2 ? s.secondBounceVpls : 0u);
+        const uint32_t count = s.firstBounceVpls + s.secondCount();
         // Sets: the N1 RSM VPLs, then each cluster's M disk VPLs (§III-A, §III-C).
         g.shading->recordGather(cmd, count, s.firstBounceVpls, std::max(s.perCluster(), 1u));
     }
@@ -204,17 +225,28 @@ void SsvpTechnique::frameFinished(TechniqueContext& ctx) {
     ctx.stat("clamped_energy_percent", clamp.removedPercent());
     ctx.stat("clamped_irradiance_mean",
              clamp.pixels > 0 ? clamp.removedIrradiance / clamp.pixels : 0.0);
-    const SsvpKmeansState k = m_gpu->propagation->readState();
+    const SsvpKmeansState k = m_gpu->propagation->readState(SsvpRange::First);
     ctx.stat("kmeans_iterations", k.iterations);
     ctx.stat("kmeans_converged", k.converged ? 1.0 : 0.0);
     m_kmeansConverged = k.converged;
     ctx.stat("kmeans_reseeded", k.reseeded);
     ctx.stat("active_clusters", k.active);
     ctx.stat("valid_first_bounce_vpls", k.assigned);
-    const SsvpMemberStats members = m_gpu->propagation->readMemberStats();
+    const SsvpMemberStats members = m_gpu->propagation->readMemberStats(SsvpRange::First);
     ctx.stat("map_sees_member_flux_percent", members.seenPercent);
     ctx.stat("shading_map_sees_member_flux_percent", members.seenAfterPercent);
     ctx.stat("moved_member_flux_percent", members.movedPercent);
+    if (m_settings.ownMapClusters() > 0) {
+        const SsvpKmeansState k2 = m_gpu->propagation->readState(SsvpRange::Second);
+        ctx.stat("second_kmeans_iterations", k2.iterations);
+        ctx.stat("second_kmeans_converged", k2.converged ? 1.0 : 0.0);
+        ctx.stat("second_active_clusters", k2.active);
+        ctx.stat("valid_second_bounce_vpls", k2.assigned);
+        m_kmeansConverged = m_kmeansConverged && k2.converged;
+        const SsvpMemberStats m2 = m_gpu->propagation->readMemberStats(SsvpRange::Second);
+        ctx.stat("second_map_sees_member_flux_percent", m2.seenPercent);
+        ctx.stat("second_shading_map_sees_member_flux_percent", m2.seenAfterPercent);
+    }
 }
 
 std::vector<DebugView> SsvpTechnique::debugViews() {
@@ -225,7 +257,7 @@ std::vector<DebugView> SsvpTechnique::debugViews() {
 bool SsvpTechnique::readVplSet(VplSet& out) {
     if (!m_gpu) return false;
     const SsvpSettings& s = m_settings;
-    const uint32_t count = s.firstBounceVpls + (s.bounces >= 2 ? s.secondBounceVpls : 0u);
+    const uint32_t count = s.firstBounceVpls + s.secondCount();
     out.vpls = m_gpu->vpls.downloadVector<GpuVpl>(count);
     const VplShadingSettings& v = m_gpu->shading->settings();
     out.clampDistance = v.clampDistance;

@@ -9,11 +9,18 @@
  *   misc.rsm            reflective shadow map of the main light (core/vpl/rsm.h)
  *   misc.vpl_sample     N1 first-bounce VPLs at the Hammersley points (Eq. 1)
  *   misc.kmeans         K-means over them, Eq. 2 (corrected), warm start, <= 5 iterations
- *   paraboloid          one layered paraboloid map per cluster (core/vpl/paraboloid_maps.h)
+ *   paraboloid.maps     one layered paraboloid map per cluster (core/vpl/paraboloid_maps.h)
+ *   misc.map_members    does each cluster's map see its members (map_members = reassign moves
+ *                       the unseen ones; ours)
  *   misc.second_bounce  N2 / C second-bounce VPLs per cluster on its map's unit disk
+ *   with second_bounce_visibility = own_maps (ours, not in the paper):
+ *     misc.second_kmeans        K-means over the second-bounce VPLs into C2 clusters
+ *     paraboloid.second_bounce  their C2 maps (layers C .. C + C2 of the same array)
+ *     misc.second_map_members   the member test for those clusters
  *   shade.gather        interleaved I x I gathering, Eq. 6 in watts, clustered visibility for
- *                       the first bounce, near-VPL clamp (core/vpl/vpl_shading.h)
- *   shade.blur          edge-aware Gaussian of the irradiance, then albedo / pi
+ *                       the first bounce (both with own_maps), near-VPL clamp
+ * (core/vpl/vpl_shading.h) shade.blur          edge-aware Gaussian of the irradiance, then albedo /
+ * pi
  */
 #include <memory>
 

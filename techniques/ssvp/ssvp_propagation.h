@@ -1,7 +1,10 @@
 #pragma once
 /**
- * The VPL clustering and propagation steps of `ssvp` (Aranha et al. §III-B, §III-C), on the GPU:
- *   recordClustering      K-means over the N1 first-bounce VPLs: seed (first frame), then per
+ * The VPL clustering and propagation steps of `ssvp` (Aranha et al. §III-B, §III-C), on the GPU.
+ * Each step runs on one VPL range: First = the N1 first-bounce VPLs in clusters [0, C); Second =
+ * with second_bounce_visibility = own_maps (ours), the N2 second-bounce VPLs in clusters
+ * [C, C + C2), whose maps are layers C.. of the same paraboloid array.
+ *   recordClustering      K-means over the range's VPLs: seed (first frame), then per
  *                         iteration an assignment dispatch and an update dispatch
  *                         (shaders/ssvp/kmeans_*.comp), warm-started from the previous frame's
  *                         centroids, stopping on convergence or after the iteration cap
@@ -22,6 +25,8 @@
 #include "techniques/ssvp/ssvp_settings.h"
 
 namespace gilab {
+
+enum class SsvpRange { First = 0, Second = 1 };
 namespace vk {
 class Context;
 }  // namespace vk
@@ -51,11 +56,11 @@ public:
 
     /** sceneDiagonal: the unit of the position term of Eq. 2 and of the eye offset. */
     void setSettings(const SsvpSettings& settings, float sceneDiagonal);
-    void recordClustering(VkCommandBuffer cmd);
-    void recordMembers(VkCommandBuffer cmd);
+    void recordClustering(VkCommandBuffer cmd, SsvpRange range);
+    void recordMembers(VkCommandBuffer cmd, SsvpRange range);
     void recordSecondBounce(VkCommandBuffer cmd);
-    SsvpKmeansState readState();
-    SsvpMemberStats readMemberStats();
+    SsvpKmeansState readState(SsvpRange range);
+    SsvpMemberStats readMemberStats(SsvpRange range);
 
 private:
     struct Push {  // mirrors KmeansPush in shaders/ssvp/kmeans_common.glsl
@@ -63,15 +68,16 @@ private:
         uint32_t count, clusterCount, iteration, metric, seed, secondCount, perCluster,
             paperWeights, secondVisibility, mapResolution, eyeAtVpl, reassign;
         float biasTexels;
-        uint32_t pad0, pad1;
+        uint32_t vplBase, clusterBase;
     };
-    void bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline);
+    /** Binds the pipeline, the range's descriptor set (its K-means state) and push constants. */
+    const Push& bind(VkCommandBuffer cmd, const vk::ComputePipeline& pipeline, SsvpRange range);
 
     SsvpSettings m_settings;
-    Push m_push{};
-    vk::Buffer m_state, m_members;
+    Push m_push[2]{};
+    vk::Buffer m_state[2], m_members;
     vk::DescriptorSetLayout m_setLayout;
-    vk::DescriptorSet m_set;
+    vk::DescriptorSet m_set[2];
     vk::PipelineLayout m_layout;
     vk::ComputePipeline m_seed, m_assign, m_update, m_second, m_memberTest, m_clusterFlux;
 };

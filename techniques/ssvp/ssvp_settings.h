@@ -12,11 +12,19 @@
 
 namespace gilab {
 
+/** How second-bounce VPLs are shadowed (the paper does not say; issue 29). */
+enum class SecondBounceVisibility {
+    None,     // unshadowed: the method as read
+    Cluster,  // the map of the nearest first-bounce cluster
+    OwnMaps,  // ours: K-means over the second-bounce VPLs, one paraboloid map per cluster
+};
+
 struct SsvpSettings {
     // Buffers and maps (Rebuild).
     uint32_t firstBounceVpls = 256;   // N1 (§III-A)
     uint32_t secondBounceVpls = 256;  // N2 (§IV-A)
     uint32_t clusters = 8;            // C (§V: 8 recommended)
+    uint32_t secondClusters = 32;     // C2, second_bounce_visibility = own_maps only (ours)
     uint32_t paraboloidResolution = 256;
     uint32_t rsmResolution = 512;
     uint32_t kmeansSeed = 1;
@@ -37,10 +45,20 @@ struct SsvpSettings {
     float clampDistance = 0.01f;  // x scene diagonal; 0 = no clamp
     float visibilityBiasTexels = 1.5f;
     bool paperWeights = false;
-    bool secondBounceVisibility = false;
+    SecondBounceVisibility secondVisibility = SecondBounceVisibility::None;
     bool reassignMembers = false;  // map_members = reassign (ours, issue 29)
 
     uint32_t perCluster() const { return clusters > 0 ? secondBounceVpls / clusters : 0; }
+    /** Second-bounce VPLs in the frame (0 with bounces = 1). */
+    uint32_t secondCount() const { return bounces >= 2 ? secondBounceVpls : 0u; }
+    /** Clusters of the second-bounce VPLs with their own maps (0 unless own_maps). */
+    uint32_t ownMapClusters() const {
+        return secondVisibility == SecondBounceVisibility::OwnMaps && secondCount() > 0
+                   ? secondClusters
+                   : 0u;
+    }
+    /** Paraboloid map layers: C, plus C2 with own_maps. */
+    uint32_t mapLayers() const { return clusters + ownMapClusters(); }
 };
 
 std::vector<ParamSpec> ssvpParamSpecs();
