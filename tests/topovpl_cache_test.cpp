@@ -303,9 +303,9 @@ TEST(CpuTopologyCache, CorruptedLengthIsRejected) {
         putU64(bytes, tailOffsets(bytes, t).voxelClusterLength, t.voxelCluster.size() - 1);
     });
     EXPECT_FALSE(why.empty());
-    // The first array's length (graph.position, right after the header).
+    // The first array's length (graph.position, right after the header and the anchored count).
     why = rejectionOf(t, [&](std::string& bytes) {
-        const size_t at = 8 + 4 + 4 + 4 + 32 + 5 * 4 + 3 * 4 + 3 * 4;
+        const size_t at = 8 + 4 + 4 + 4 + 32 + 5 * 4 + 3 * 4 + 3 * 4 + 8;
         putU64(bytes, at, ~uint64_t(0));
     });
     EXPECT_NE(why.find("graph.position"), std::string::npos) << why;

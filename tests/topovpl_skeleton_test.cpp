@@ -87,6 +87,82 @@ Topo segment(const Rooms& rooms, bool mergeVisible = true, float alpha = 0.2f,
     return t;
 }
 
+/** A straight chain of nodes 30 voxels apart (farther than any ball: every node is kept as a
+ *  coverage node), radii as given. */
+topo::SkeletonGraph chain(const std::vector<float>& radii, float spacing = 30.0f) {
+    topo::SkeletonGraph g;
+    for (size_t i = 0; i < radii.size(); ++i) {
+        g.position.emplace_back(spacing * float(i), 0.0f, 0.0f);
+        g.maxball.push_back(radii[i]);
+        g.adjacency.emplace_back();
+        if (i > 0) g.adjacency[i].push_back(uint32_t(i - 1));
+        if (i + 1 < radii.size()) g.adjacency[i].push_back(uint32_t(i + 1));
+        g.voxelNode.push_back(uint32_t(i));
+    }
+    return g;
+}
+
+// E3's two readings on radii that shrink by 0.8 voxel a node from 10: the seed rule
+// (|r - R_C| <= 0.2 R_C) stops a cluster where the radius is 2 below the seed's; the chained
+// rule (|r - r_m| <= 0.2 R_C) follows the gradual narrowing to the end.
+TEST(CpuTopoSkeleton, ChainedClustersFollowAGradualNarrowing) {
+    const topo::SkeletonGraph g = chain({10.0f, 9.2f, 8.4f, 7.6f, 6.8f, 6.0f});
+    topo::Segmentation seed = topo::segmentSkeleton(g);
+    ASSERT_EQ(seed.kept.size(), 6u);
+    topo::Segmentation chained = seed;
+    topo::clusterSkeleton(g, seed, 0.2f, {}, GridDims{}, false, topo::GatePlacement::Midpoint, 1.0f,
+                          topo::ClusterRule::Seed);
+    topo::clusterSkeleton(g, chained, 0.2f, {}, GridDims{}, false, topo::GatePlacement::Midpoint,
+                          1.0f, topo::ClusterRule::Chained);
+    // Seed: {10, 9.2, 8.4} (7.6 is 2.4 below 10), {7.6, 6.8} (6.0 is 1.6 > 0.2 x 7.6 below), {6}.
+    EXPECT_EQ(seed.cluster, (std::vector<uint32_t>{0, 0, 0, 1, 1, 2}));
+    EXPECT_EQ(seed.gates.size(), 2u);
+    EXPECT_EQ(chained.clusterCount, 1u);
+    EXPECT_TRUE(chained.gates.empty());
+}
+
+// Chessboard balls are cubes: a node at (d, d, d) from a centre of radius d is inside it, and
+// outside the Euclidean ball of the same radius.
+TEST(CpuTopoSkeleton, ChessboardBallsAreCubes) {
+    topo::SkeletonGraph g = chain({4.0f, 1.0f}, 10.0f);
+    const glm::vec3 corner = g.position[0] + glm::vec3(4.0f, 4.0f, -4.0f);
+    EXPECT_FALSE(g.inBall(0, corner));
+    EXPECT_NEAR(g.ballDistance(0, corner), std::sqrt(48.0f), 1e-5f);
+    g.metric = topo::BallMetric::Chessboard;
+    EXPECT_TRUE(g.inBall(0, corner));
+    EXPECT_FLOAT_EQ(g.ballDistance(0, corner), 4.0f);
+    EXPECT_FALSE(g.inBall(0, corner + glm::vec3(0.0f, 0.01f, 0.0f)));
+}
+
+// E2's split point on a line a - n1 - n2 - n3 - b whose middle node n2 has a ball of 12 that
+// covers n1 and n3: splitting at the most uncovered node (n2) keeps one coverage node; splitting
+// at the first (n1) keeps n1, then n2.
+TEST(CpuTopoSkeleton, CoverageSplitAtTheMostUncoveredNode) {
+    topo::SkeletonGraph g = chain({5.0f, 1.0f, 12.0f, 1.0f, 5.0f});
+    g.position = {{0, 0, 0}, {6, 0, 0}, {15, 0, 0}, {24, 0, 0}, {30, 0, 0}};
+    const topo::Segmentation first = topo::segmentSkeleton(g, topo::CoverageSplit::First);
+    const topo::Segmentation most = topo::segmentSkeleton(g, topo::CoverageSplit::Most);
+    EXPECT_EQ(first.coverageNodes, 2u);
+    EXPECT_EQ(first.kind[1], topo::NodeKind::Coverage);
+    EXPECT_EQ(first.kind[2], topo::NodeKind::Coverage);
+    EXPECT_EQ(most.coverageNodes, 1u);
+    EXPECT_EQ(most.kind[2], topo::NodeKind::Coverage);
+    EXPECT_EQ(most.kind[1], topo::NodeKind::Line);
+    EXPECT_EQ(most.kind[3], topo::NodeKind::Line);
+    // The line nodes map to the nearer kept node.
+    EXPECT_EQ(most.segmentedNode[1], 0u);
+    EXPECT_EQ(most.segmentedNode[3], 4u);
+}
+
+// A node that holds most of the skeleton's voxels (a clump of empty space that did not thin).
+TEST(CpuTopoSkeleton, LargestNodeShareOfTheSkeleton) {
+    topo::SkeletonGraph g = chain({1.0f, 1.0f, 1.0f});
+    g.voxelNode = {0, 1, 1, 1, 2, 1, 1, 1};
+    uint32_t node = 99;
+    EXPECT_FLOAT_EQ(topo::largestNodeSkeletonPercent(g, &node), 75.0f);
+    EXPECT_EQ(node, 1u);
+}
+
 // A line with two side branches at its middle: the short one lies inside the junction's maximal
 // ball and is pruned (its voxels map to the junction); the long one is kept.
 TEST(CpuTopoSkeleton, CoveredSpursArePruned) {

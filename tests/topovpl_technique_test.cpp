@@ -193,6 +193,28 @@ TEST_F(GpuTopovpl, ClampIsMeasuredAndNoNaNNearVpls) {
     EXPECT_LT(test::indirectLayerSum(on.layers), test::indirectLayerSum(off.layers));
 }
 
+// The diagnostic same-cluster share (diag.same_cluster_share) is what its definition says: the
+// image lit by same-cluster VPLs only (visibility = same_cluster: unshadowed, no gates) over the
+// image lit by every VPL unshadowed (visibility = none). Two rooms, door open: every covered
+// pixel has a cluster, and room A's VPLs light room B only across clusters.
+TEST_F(GpuTopovpl, SameClusterShareIsTheSameClusterImageOverTheUnshadowedOne) {
+    const Scene scene = loadScene("stress/two_rooms_door.json", "", 48);
+    const Frame same = renderOnce(*m_ctx, scene, {{"visibility", "same_cluster"}});
+    const Frame none = renderOnce(*m_ctx, scene, {{"visibility", "none"}});
+    const double share = statOf(same, "same_cluster_unshadowed_percent");
+    EXPECT_NEAR(statOf(none, "same_cluster_unshadowed_percent"), share, 1e-3);
+    const double ratio =
+        100.0 * test::indirectLayerSum(same.layers) / test::indirectLayerSum(none.layers);
+    std::printf("same-cluster share %.3f %%, image ratio %.3f %%\n", share, ratio);
+    EXPECT_GT(share, 1.0);
+    EXPECT_LT(share, 99.0);
+    EXPECT_NEAR(share, ratio, 0.01 * ratio);
+    // Off: no stat, no pass.
+    const Frame off = renderOnce(*m_ctx, scene, {{"same_cluster_stat", "off"}});
+    for (const auto& [n, v] : off.stats)
+        EXPECT_NE(n, "same_cluster_unshadowed_percent");
+}
+
 // A light-assignment buffer too small for the lists: the overflow is counted, never silent, and
 // the image only loses light.
 TEST_F(GpuTopovpl, ListOverflowIsCountedAndReported) {

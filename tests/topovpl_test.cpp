@@ -67,7 +67,7 @@ TEST_F(GpuTopology, CornellBoxTopologyLabelsTheEmptySpace) {
         ASSERT_LT(c, t.segmentation.clusterCount);
         ++labelled;
     }
-    // The grid's border closes the box's open front, so all the empty space is one piece.
+    // The scene's bounds close the box's open front, so all the empty space is one piece.
     EXPECT_EQ(labelled, size_t(t.emptyVoxels));
     for (const topo::WorldGate& g : t.gates) {
         EXPECT_GT(g.radius, 0.0f);
@@ -114,6 +114,29 @@ TEST_F(GpuTopology, EveryTwoRoomPixelGetsACluster) {
     const topo::SceneTopology t = topology64(*m_ctx, gpuScene, scene);
     std::printf("two rooms 64^3: %u clusters, %zu gates\n", t.segmentation.clusterCount,
                 t.gates.size());
+    // The empty space ends at the scene's bounds, not at the cube grid's border
+    // (the rooms are twice as long as high: most of the cube lies outside them). Every voxel
+    // beyond them is solid, so no cluster and no skeleton voxel lies there.
+    const glm::ivec3 lo = t.grid.voxelOf(scene.caps.bounds.lo) - topo::kBoundsMarginVoxels;
+    const glm::ivec3 hi = t.grid.voxelOf(scene.caps.bounds.hi) + topo::kBoundsMarginVoxels;
+    size_t outside = 0;
+    for (uint32_t z = 0; z < t.dims.nz; ++z)
+        for (uint32_t y = 0; y < t.dims.ny; ++y)
+            for (uint32_t x = 0; x < t.dims.nx; ++x) {
+                const glm::ivec3 c(x, y, z);
+                if (glm::all(glm::greaterThanEqual(c, lo)) && glm::all(glm::lessThanEqual(c, hi)))
+                    continue;
+                ++outside;
+                ASSERT_EQ(t.voxelCluster[t.dims.index(x, y, z)], topo::kNoNode)
+                    << x << " " << y << " " << z;
+            }
+    EXPECT_GT(outside, t.dims.count() / 4);
+    for (const glm::vec3& p : t.graph.position) {
+        EXPECT_TRUE(glm::all(glm::greaterThanEqual(p, glm::vec3(lo))));
+        EXPECT_TRUE(glm::all(glm::lessThanEqual(p, glm::vec3(hi))));
+    }
+    // No node is a clump of unthinned empty space.
+    EXPECT_LT(topo::largestNodeSkeletonPercent(t.graph), 5.0f);
     const uint32_t w = uint32_t(scene.settings.width), h = uint32_t(scene.settings.height);
     SharedPasses passes(*m_ctx, gpuScene, w, h);
     topo::PixelClusters pixels(*m_ctx, passes.gbuffer(), t, "test");

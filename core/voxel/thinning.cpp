@@ -1,9 +1,11 @@
 #include "core/voxel/thinning.h"
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -151,33 +153,59 @@ bool isCurveEnd(const PaddedGrid& g, size_t i, uint32_t mask) {
     return std::popcount(g.mask(q) & kTables.n26) == 2;
 }
 
+// ---------------------------------------------------------------------------------------------
+// Lifespan filter (Chaussard, Noel, Biri & Couprie 2013)
+// ---------------------------------------------------------------------------------------------
+
+constexpr uint32_t kUnborn = std::numeric_limits<uint32_t>::max();
+
+/** Per live voxel (parallel to `live`): the pass at whose end it first had at most two object
+ *  26-neighbours (kUnborn before), and opening - distance, the lifespan it must exceed. */
+struct Lifespan {
+    std::vector<uint32_t> birth;
+    std::vector<int32_t> slack;  // clamped to int32: lifespans are pass counts, far below 2^31
+
+    /** Anchored (never deleted) during pass `pass`: born, and pass - birth > slack. */
+    bool anchored(size_t k, uint32_t pass) const {
+        return birth[k] != kUnborn && int64_t(pass) - int64_t(birth[k]) > slack[k];
+    }
+};
+
 /** One subiteration of direction `dir`: parallel marking on the current set, then sequential
  *  deletion in ascending index order re-checking simplicity (Lee, Kashyap & Chu 1994). Phase 1
  *  (`phase1`) also asks the opposite neighbour to be object and takes curve-end status from the
- *  marking; phase 2 re-checks it at deletion. Returns the number deleted. */
+ *  marking; phase 2 re-checks it at deletion. With `lifespan`, anchoring (fixed for the pass
+ *  `pass`) replaces the curve-end test in both. Returns the number deleted. */
 uint64_t runSubiteration(PaddedGrid& g, const std::vector<uint32_t>& live, int dir, bool phase1,
-                         std::vector<uint8_t>& marked) {
+                         std::vector<uint8_t>& marked, const Lifespan* lifespan, uint32_t pass) {
     const int64_t dOff = g.offset[kDirectionBit[dir]];
     const int64_t oppOff = g.offset[kOppositeBit[dir]];
     marked.assign(live.size(), 0);
-    // Mark simple d-border points that are not curve ends (reads only: thread-count independent)
-    tbb::parallel_for(tbb::blocked_range<size_t>(0, live.size(), 2048),
-                      [&](const tbb::blocked_range<size_t>& r) {
-                          for (size_t k = r.begin(); k != r.end(); ++k) {
-                              const size_t i = live[k];
-                              if (g.v[i] == 0 || g.v[i + dOff] != 0) continue;
-                              if (phase1 && g.v[i + oppOff] == 0) continue;
-                              const uint32_t mask = g.mask(i);
-                              marked[k] = isSimpleMask(mask) && !isCurveEnd(g, i, mask);
-                          }
-                      });
+    // Mark simple d-border points that are not curve ends, or with `lifespan` not anchored
+    // (reads only: thread-count independent)
+    tbb::parallel_for(
+        tbb::blocked_range<size_t>(0, live.size(), 2048), [&](const tbb::blocked_range<size_t>& r) {
+            for (size_t k = r.begin(); k != r.end(); ++k) {
+                const size_t i = live[k];
+                if (g.v[i] == 0 || g.v[i + dOff] != 0) continue;
+                if (lifespan != nullptr) {
+                    // Phase 1's opposite-neighbour rule keeps layers; a born voxel is 1D already
+                    if (phase1 && g.v[i + oppOff] == 0 && lifespan->birth[k] == kUnborn) continue;
+                    marked[k] = !lifespan->anchored(k, pass) && isSimpleMask(g.mask(i));
+                    continue;
+                }
+                if (phase1 && g.v[i + oppOff] == 0) continue;
+                const uint32_t mask = g.mask(i);
+                marked[k] = isSimpleMask(mask) && !isCurveEnd(g, i, mask);
+            }
+        });
     // Delete sequentially; each deletion is of a point simple in the current set
     uint64_t removed = 0;
     for (size_t k = 0; k < live.size(); ++k) {
         if (marked[k] == 0) continue;
         const size_t i = live[k];
         const uint32_t mask = g.mask(i);
-        if (isSimpleMask(mask) && (phase1 || !isCurveEnd(g, i, mask))) {
+        if (isSimpleMask(mask) && (phase1 || lifespan != nullptr || !isCurveEnd(g, i, mask))) {
             g.v[i] = 0;
             ++removed;
         }
@@ -188,26 +216,96 @@ uint64_t runSubiteration(PaddedGrid& g, const std::vector<uint32_t>& live, int d
 }  // namespace
 
 ThinningStats thinCurveSkeleton(std::vector<uint8_t>& object, const GridDims& dims) {
+    return thinCurveSkeleton(object, dims, ThinningOptions{});
+}
+
+ThinningStats thinCurveSkeleton(std::vector<uint8_t>& object, const GridDims& dims,
+                                const ThinningOptions& options) {
     validate(object.size(), dims, "thinCurveSkeleton");
+    const bool useLifespan = options.distance != nullptr || options.opening != nullptr;
+    if (useLifespan) {
+        if (options.distance == nullptr || options.opening == nullptr) {
+            throw Error(std::string("thinCurveSkeleton: the lifespan filter needs both ") +
+                        "ThinningOptions::distance and ::opening, got only " +
+                        (options.distance != nullptr ? "distance" : "opening"));
+        }
+        for (const auto& [map, name] :
+             {std::pair{options.distance, "distance"}, std::pair{options.opening, "opening"}}) {
+            if (map->size() != object.size()) {
+                throw Error(std::string("thinCurveSkeleton: ThinningOptions::") + name + " has " +
+                            std::to_string(map->size()) + " values, the object " +
+                            std::to_string(object.size()));
+            }
+        }
+    }
     PaddedGrid g(object, dims);
     std::vector<uint32_t> live;  // padded indices of object voxels, ascending
     for (size_t i = 0; i < g.v.size(); ++i) {
         if (g.v[i] != 0) live.push_back(uint32_t(i));
     }
     ThinningStats stats;
+    Lifespan lifespan;
+    // Records as born at pass `pass` every unborn live voxel with at most two object neighbours
+    const auto recordBirths = [&](uint32_t pass) {
+        tbb::parallel_for(tbb::blocked_range<size_t>(0, live.size(), 2048),
+                          [&](const tbb::blocked_range<size_t>& r) {
+                              for (size_t k = r.begin(); k != r.end(); ++k) {
+                                  if (lifespan.birth[k] != kUnborn) continue;
+                                  if (std::popcount(g.mask(live[k]) & kTables.n26) <= 2) {
+                                      lifespan.birth[k] = pass;
+                                  }
+                              }
+                          });
+    };
+    if (useLifespan) {
+        lifespan.birth.assign(live.size(), kUnborn);
+        lifespan.slack.resize(live.size());
+        for (size_t k = 0; k < live.size(); ++k) {
+            // Padded index to grid index: x + 1 + px * (y + 1 + py * (z + 1))
+            const uint32_t i = live[k];
+            const uint32_t x = i % g.px - 1, y = i / g.px % g.py - 1, z = i / g.px / g.py - 1;
+            const size_t j = dims.index(x, y, z);
+            const int64_t slack = int64_t((*options.opening)[j]) - int64_t((*options.distance)[j]);
+            lifespan.slack[k] = int32_t(std::clamp<int64_t>(
+                slack, std::numeric_limits<int32_t>::min(), std::numeric_limits<int32_t>::max()));
+        }
+        recordBirths(0);  // already a curve in the input: born before the first pass
+    }
     std::vector<uint8_t> marked;
     for (const bool phase1 : {true, false}) {
         // Passes of U, D, N, S, E, W until one deletes nothing
         for (;;) {
             uint64_t removed = 0;
+            const uint32_t pass = stats.iterations + 1;
             for (int dir = 0; dir < 6; ++dir) {
-                removed += runSubiteration(g, live, dir, phase1, marked);
+                removed += runSubiteration(g, live, dir, phase1, marked,
+                                           useLifespan ? &lifespan : nullptr, pass);
             }
             ++stats.iterations;
             stats.removed += removed;
             if (removed == 0) break;
-            std::erase_if(live, [&](uint32_t i) { return g.v[i] == 0; });
+            if (!useLifespan) {
+                std::erase_if(live, [&](uint32_t i) { return g.v[i] == 0; });
+                continue;
+            }
+            size_t kept = 0;  // compact live and its lifespan records together
+            for (size_t k = 0; k < live.size(); ++k) {
+                if (g.v[live[k]] == 0) continue;
+                live[kept] = live[k];
+                lifespan.birth[kept] = lifespan.birth[k];
+                lifespan.slack[kept] = lifespan.slack[k];
+                ++kept;
+            }
+            live.resize(kept);
+            lifespan.birth.resize(kept);
+            lifespan.slack.resize(kept);
+            recordBirths(pass);
         }
+    }
+    if (useLifespan) {
+        // The anchoring in force during the last pass, which deleted nothing
+        for (size_t k = 0; k < live.size(); ++k)
+            stats.anchored += lifespan.anchored(k, stats.iterations);
     }
     g.copyBack(object, dims);
     return stats;

@@ -35,7 +35,26 @@
  *     (a component with no tunnel and no end long enough may shrink to one voxel).
  *   - Determinism: the output does not depend on the number of threads (marking only reads).
  *   - Not guaranteed: a unique or exactly centred skeleton (order-dependent by a voxel or so);
- *     spurs longer than one voxel from bumps of the shape are kept, as by any end-point rule.
+ *     spurs longer than one voxel from bumps of the shape are kept, as by any end-point rule
+ *     (unless the lifespan filter below is on).
+ *
+ * Lifespan filter (optional, ThinningOptions), the authors' rule for those spurs (Chaussard,
+ * Noël, Biri & Couprie, DGCI 2013): the lifespan of a skeleton element is the number of passes
+ * since it became 1D; it is kept iff lifespan > opening - distance (chessboard distance of the
+ * voxel to the background and its opening, core/voxel/distance_transform.h).
+ * Here: passes are numbered 1, 2, ... across both phases; a voxel is born at the end of the first
+ * pass after which it has at most two object 26-neighbours (pass 0: already so in the input).
+ * During pass P it is anchored, never deleted, iff born and P - birth > opening - distance; a
+ * centre of its own maximal ball (opening == distance) is anchored from the pass after its
+ * birth, a spur voxel near a bump (inside a larger ball) only after many passes. Curve-end status
+ * no longer protects anything: unanchored simple voxels are candidates like any other, so spurs
+ * erode from their tips (one or more voxels a pass) while the main branches wait to be anchored.
+ * Born voxels also skip phase 1's opposite-neighbour condition (they are 1D, no layer is left to
+ * keep): a tip whose only neighbour is diagonal has no face neighbour, so it could never be a
+ * phase-1 candidate and would outlive its slack before phase 2 began.
+ * Topology, the sequential re-check and thread-count independence are unchanged (births are
+ * recorded in parallel from the current set only); on return every voxel is non-simple or
+ * anchored. Extra cost: one neighbour count per unborn voxel and pass, 8 bytes per object voxel.
  * Grid border: voxels outside the grid are background (the object is padded by one empty layer).
  * Cost: O(passes * live object voxels); passes ~ half the largest object thickness.
  */
@@ -49,6 +68,14 @@ namespace gilab {
 struct ThinningStats {
     uint32_t iterations = 0;  // passes of 6 subiterations, both phases, the last empty one counted
     uint64_t removed = 0;     // voxels deleted
+    uint64_t anchored = 0;    // lifespan filter: voxels left that are anchored (0 without it)
+};
+
+/** The lifespan filter (file comment): both set, or both null for plain curve-end thinning. */
+struct ThinningOptions {
+    const std::vector<uint32_t>* distance = nullptr;  // chessboard distance of the object voxels
+                                                      // to the background, grid-indexed
+    const std::vector<uint32_t>* opening = nullptr;   // its opening (chessboardOpening)
 };
 
 /** Thins the object voxels (object[i] != 0) in place to a 26-connected curve skeleton (see the
@@ -56,6 +83,12 @@ struct ThinningStats {
  *  gilab::Error naming the problem when a dimension is 0, object.size() != nx*ny*nz, or the
  *  padded grid exceeds 2^32 voxels. */
 ThinningStats thinCurveSkeleton(std::vector<uint8_t>& object, const GridDims& dims);
+
+/** The same with options: with options.distance and options.opening set, the lifespan filter
+ *  replaces curve-end protection (file comment); with both null, exactly the overload above.
+ *  Also throws gilab::Error when only one is set or either's size != object.size(). */
+ThinningStats thinCurveSkeleton(std::vector<uint8_t>& object, const GridDims& dims,
+                                const ThinningOptions& options);
 
 /** Exposed for tests: is voxel (x,y,z) a simple point of the object (26/6)? Looks only at its 26
  *  neighbours (the value of (x,y,z) itself is ignored); outside the grid is background. Throws

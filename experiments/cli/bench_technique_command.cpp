@@ -63,7 +63,7 @@ void benchOne(vk::Context& ctx, const Scene& scene, const std::string& id,
         for (const vk::PassTime& p : t.passes) {
             if (!passes.count(p.name)) order.push_back(p.name);
             passes[p.name].push_back(p.gpuMs);
-            sum += p.gpuMs;
+            if (!isDiagnosticPass(p.name)) sum += p.gpuMs;
         }
         frameGpu.push_back(sum);
     }

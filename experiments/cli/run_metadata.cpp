@@ -39,13 +39,15 @@ nlohmann::ordered_json number(double v) {
 }
 
 /**
- * Sum of a frame's pass times without double counting: a nested pass is named
+ * Sum of a frame's pass times without double counting (diagnostic passes left out): a nested
+ * pass is named
  * "<parent>.<child>" (e.g. "vct/inject.splat" inside "vct/inject") and is left out when its
  * parent is in the list; "shadow_maps.update" has no parent "shadow_maps" there and counts.
  */
 double topLevelGpuMs(const std::vector<const vk::PassTime*>& passes) {
     double total = 0.0;
     for (const vk::PassTime* p : passes) {
+        if (isDiagnosticPass(p->name)) continue;
         const size_t dot = p->name.rfind('.');
         const bool nested = dot != std::string::npos &&
                             std::any_of(passes.begin(), passes.end(), [&](const vk::PassTime* q) {
@@ -64,6 +66,11 @@ nlohmann::ordered_json summaryJson(const std::vector<double>& values) {
 }
 
 }  // namespace
+
+bool isDiagnosticPass(const std::string& name) {
+    const size_t slash = name.find('/');
+    return name.compare(slash == std::string::npos ? 0 : slash + 1, 5, "diag.") == 0;
+}
 
 std::string isoDateUtc() {
     const std::time_t now = std::time(nullptr);

@@ -19,6 +19,9 @@ namespace cli {
 
 /** git commit, version, compiler, build type, date (UTC, ISO 8601), host, CPU, command line. */
 nlohmann::ordered_json provenanceJson(const std::string& commandLine);
+/** A diagnostic pass, "<technique>/diag.<name>": it measures the method, is timed, and is left
+ *  out of the frame's GPU time (docs/timing.md). */
+bool isDiagnosticPass(const std::string& name);
 nlohmann::ordered_json deviceJson(const vk::Context& ctx);
 nlohmann::ordered_json sceneToJson(const Scene& scene);
 /** Setup times, the warm-up, then per-frame CPU and per-pass GPU times as median / IQR over the

@@ -84,6 +84,7 @@ GateLighting::GateLighting(vk::Context& ctx, GBuffer& gbuffer, PixelClusters& pi
     m_entries = buffer(m_capacity * 8, "la_entries");
     m_state = buffer(32, "state", VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT);
     m_partials = buffer(VkDeviceSize(groupCount(m_width, m_height)) * 16, "clamp_partials");
+    m_sharePartials = buffer(VkDeviceSize(groupCount(m_width, m_height)) * 16, "share_partials");
     m_gates.uploadVector(table.gates);
     m_clusterStart.uploadVector(table.clusterStart);
     m_clusterGates.uploadVector(table.clusterGates);
@@ -91,7 +92,8 @@ GateLighting::GateLighting(vk::Context& ctx, GBuffer& gbuffer, PixelClusters& pi
                                                 VK_IMAGE_USAGE_STORAGE_BIT, tag + "/geo_clusters"));
     ctx.submitAndWait([&](VkCommandBuffer cmd) {
         m_geoImage.transition(cmd, VK_IMAGE_LAYOUT_GENERAL);
-        for (vk::Buffer* b : {&m_vplClusters, &m_geo, &m_counts, &m_offsets, &m_state, &m_partials})
+        for (vk::Buffer* b : {&m_vplClusters, &m_geo, &m_counts, &m_offsets, &m_state, &m_partials,
+                              &m_sharePartials})
             vkCmdFillBuffer(cmd, b->handle(), 0, VK_WHOLE_SIZE, 0);
     });
 
@@ -139,6 +141,28 @@ GateLighting::GateLighting(vk::Context& ctx, GBuffer& gbuffer, PixelClusters& pi
     m_il.set.writeBuffer(7, m_offsets);
     m_il.set.writeBuffer(8, m_entries);
     m_il.set.writeBuffer(10, m_partials);
+
+    m_share = makeStage(ctx, {kImage, kImage, kImage, kImage, kBuffer, kBuffer, kBuffer}, 8,
+                        "topovpl/same_cluster_share.comp", tag + "/same_cluster_share");
+    m_share.set.writeStorageImage(0, gbuffer.position.view());
+    m_share.set.writeStorageImage(1, gbuffer.normal.view());
+    m_share.set.writeStorageImage(2, gbuffer.albedo.view());
+    m_share.set.writeStorageImage(3, pixels.clusters().view());
+    m_share.set.writeBuffer(4, vpls);
+    m_share.set.writeBuffer(5, m_vplClusters);
+    m_share.set.writeBuffer(6, m_sharePartials);
+}
+
+void GateLighting::recordSameClusterShare(VkCommandBuffer cmd, float clampDistance) {
+    m_share.bind(cmd);
+    const struct {
+        float clamp;
+        uint32_t vplCount;
+    } push{clampDistance, m_vplCount};
+    m_share.layout.push(cmd, push);
+    vk::dispatch2D(cmd, m_width, m_height, kGroup, kGroup);
+    vk::memoryBarrier(cmd);
+    vk::hostReadBarrier(cmd);
 }
 
 void GateLighting::updateGates(const std::vector<GpuGate>& gates) {
@@ -224,6 +248,11 @@ GateLightingStats GateLighting::readStats() {
         s.keptIrradiance += g.x;
         s.removedIrradiance += g.y;
     }
+    m_sharePartials.download(sums.data(), VkDeviceSize(groups) * 16);
+    for (const glm::vec4& g : sums) {
+        s.unshadowedRadiance += g.x;
+        s.sameClusterRadiance += g.y;
+    }
     const std::vector<GpuVpl> vpls = m_vpls.downloadVector<GpuVpl>(m_vplCount);
     const std::vector<uint32_t> clusters = m_vplClusters.downloadVector<uint32_t>(m_vplCount);
     for (uint32_t i = 0; i < m_vplCount; ++i) {
@@ -236,8 +265,9 @@ GateLightingStats GateLighting::readStats() {
 
 uint64_t GateLighting::bytes() const {
     uint64_t total = 0;
-    for (const vk::Buffer* b : {&m_vplClusters, &m_gates, &m_clusterStart, &m_clusterGates, &m_geo,
-                                &m_counts, &m_offsets, &m_entries, &m_state, &m_partials})
+    for (const vk::Buffer* b :
+         {&m_vplClusters, &m_gates, &m_clusterStart, &m_clusterGates, &m_geo, &m_counts, &m_offsets,
+          &m_entries, &m_state, &m_partials, &m_sharePartials})
         total += b->size();
     return total + uint64_t(m_width) * m_height * 4;
 }

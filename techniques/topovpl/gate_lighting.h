@@ -59,6 +59,9 @@ struct GateLightingStats {
     uint64_t overflow = 0;  // entries that did not fit the buffer
     double keptIrradiance = 0.0, removedIrradiance = 0.0;  // clamp sums (mean of rgb)
     uint32_t validVpls = 0, vplsWithoutCluster = 0;
+    // recordSameClusterShare: outgoing radiance (mean of rgb) summed over the image, every VPL
+    // unshadowed and only the VPLs of the pixel's own visibility cluster.
+    double unshadowedRadiance = 0.0, sameClusterRadiance = 0.0;
 };
 
 class GateLighting {
@@ -78,6 +81,9 @@ public:
                     float zNear, float zFar, uint32_t tile, uint32_t slices);
     void recordLa(VkCommandBuffer cmd, LaMode mode, bool farClusterOnly);
     void recordIl(VkCommandBuffer cmd, vk::Image& indirect, float clampDistance);
+    /** Diagnostic (same_cluster_share.comp): every pixel against every VPL, unshadowed, summed
+     *  over the image, all pairs and same-visibility-cluster pairs (readStats). */
+    void recordSameClusterShare(VkCommandBuffer cmd, float clampDistance);
 
     GateLightingStats readStats();
     uint64_t entryCapacity() const { return m_capacity; }
@@ -101,10 +107,10 @@ private:
     uint64_t m_capacity;
     VoxelGrid m_grid;
     vk::Buffer m_vplClusters, m_gates, m_clusterStart, m_clusterGates;
-    vk::Buffer m_geo, m_counts, m_offsets, m_entries, m_state, m_partials;
+    vk::Buffer m_geo, m_counts, m_offsets, m_entries, m_state, m_partials, m_sharePartials;
     vk::Image m_geoImage;
     vk::Buffer& m_vpls;
-    Stage m_vplStage, m_iugc, m_laArgs, m_laAssign, m_laScan, m_il;
+    Stage m_vplStage, m_iugc, m_laArgs, m_laAssign, m_laScan, m_il, m_share;
     VkImageView m_boundIndirect = VK_NULL_HANDLE;
 };
 

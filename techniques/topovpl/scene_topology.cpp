@@ -23,14 +23,30 @@ SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene,
         const VoxelData data = voxelizer.readVoxels();
         for (size_t i = 0; i < solid.size(); ++i)
             solid[i] = data.count[i] > 0 ? 1 : 0;
-        for (uint32_t z = 0; z < n; ++z)  // close the empty space with the grid's border
+        // Close the empty space a margin beyond the scene's bounds (and at the grid's border).
+        const glm::ivec3 lo = t.grid.voxelOf(scene.caps.bounds.lo) - kBoundsMarginVoxels;
+        const glm::ivec3 hi = t.grid.voxelOf(scene.caps.bounds.hi) + kBoundsMarginVoxels;
+        const int last = int(n) - 1;
+        for (uint32_t z = 0; z < n; ++z)
             for (uint32_t y = 0; y < n; ++y)
-                for (uint32_t x = 0; x < n; ++x)
-                    if (x == 0 || y == 0 || z == 0 || x == n - 1 || y == n - 1 || z == n - 1)
+                for (uint32_t x = 0; x < n; ++x) {
+                    const glm::ivec3 c(x, y, z);
+                    if (glm::any(glm::lessThan(c, glm::max(lo, glm::ivec3(1)))) ||
+                        glm::any(glm::greaterThan(c, glm::min(hi, glm::ivec3(last - 1)))))
                         solid[t.dims.index(x, y, z)] = 1;
+                }
     });
     std::vector<float> radius;
-    time("distance_transform", [&] { radius = distanceTransform(solid, t.dims); });
+    std::vector<uint32_t> chessboard, opening;
+    time("distance_transform", [&] {
+        if (s.ballMetric == BallMetric::Euclidean) radius = distanceTransform(solid, t.dims);
+        if (s.ballMetric == BallMetric::Chessboard || s.skeletonFilter == SkeletonFilter::Lifespan)
+            chessboard = chessboardDistanceTransform(solid, t.dims);
+        if (s.ballMetric == BallMetric::Chessboard)
+            radius.assign(chessboard.begin(), chessboard.end());
+        if (s.skeletonFilter == SkeletonFilter::Lifespan)
+            opening = chessboardOpening(chessboard, t.dims);
+    });
     std::vector<uint8_t> empty(solid.size());
     for (size_t i = 0; i < empty.size(); ++i) {
         empty[i] = solid[i] ? 0 : 1;
@@ -38,7 +54,14 @@ SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene,
     }
     t.solidVoxels = uint32_t(solid.size()) - t.emptyVoxels;
     std::vector<uint8_t> skeleton = empty;
-    time("thinning", [&] { thinCurveSkeleton(skeleton, t.dims); });
+    time("thinning", [&] {
+        ThinningOptions options;
+        if (s.skeletonFilter == SkeletonFilter::Lifespan) {
+            options.distance = &chessboard;
+            options.opening = &opening;
+        }
+        t.anchoredVoxels = thinCurveSkeleton(skeleton, t.dims, options).anchored;
+    });
     std::vector<glm::ivec3> voxels;
     std::vector<float> radii;
     for (uint32_t z = 0; z < n; ++z)
@@ -50,12 +73,13 @@ SceneTopology buildSceneTopology(vk::Context& ctx, const vk::GpuScene& gpuScene,
                 }
     t.skeletonVoxels = uint32_t(voxels.size());
     time("segmentation", [&] {
-        t.graph = buildSkeletonGraph(voxels, radii);
-        t.segmentation = segmentSkeleton(t.graph);
+        t.graph = buildSkeletonGraph(voxels, radii, s.skeletonFilter == SkeletonFilter::SpurPrune,
+                                     s.ballMetric);
+        t.segmentation = segmentSkeleton(t.graph, s.coverageSplit);
     });
     time("clustering", [&] {
         clusterSkeleton(t.graph, t.segmentation, s.alpha, empty, t.dims, s.mergeVisible,
-                        s.gatePlacement, s.mergeVisibility);
+                        s.gatePlacement, s.mergeVisibility, s.clusterRule);
     });
     time("nearest_node", [&] {
         const std::vector<uint32_t> labels =

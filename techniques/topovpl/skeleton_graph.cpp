@@ -97,19 +97,24 @@ void splitAtCurvature(const SkeletonGraph& g, std::vector<Piece>& pieces,
     pieces = std::move(done);
 }
 
-/** (E2): splits pieces at the first node (from a) outside both extrema's maximal balls. */
+/** (E2): splits pieces at the first node (from a) outside both extrema's maximal balls, or at
+ *  the most uncovered one (CoverageSplit::Most: the largest distance outside the nearer ball). */
 void splitAtCoverage(const SkeletonGraph& g, std::vector<Piece>& pieces,
-                     std::vector<NodeKind>& kind) {
+                     std::vector<NodeKind>& kind, CoverageSplit split) {
     std::vector<Piece> done, work = std::move(pieces);
     while (!work.empty()) {
         Piece p = std::move(work.back());
         work.pop_back();
         int at = -1;
-        for (size_t k = 0; k < p.chain.size() && at < 0; ++k) {
+        float worst = 0.0f;
+        for (size_t k = 0; k < p.chain.size(); ++k) {
             const glm::vec3& x = g.position[p.chain[k]];
-            const bool covered = glm::length(x - g.position[p.a]) <= g.maxball[p.a] ||
-                                 glm::length(x - g.position[p.b]) <= g.maxball[p.b];
-            if (!covered) at = int(k);
+            const float outside = std::min(g.ballDistance(p.a, x) - g.maxball[p.a],
+                                           g.ballDistance(p.b, x) - g.maxball[p.b]);
+            if (outside <= worst) continue;  // covered (or less uncovered than the worst)
+            worst = outside;
+            at = int(k);
+            if (split == CoverageSplit::First) break;
         }
         if (at < 0) {
             done.push_back(std::move(p));
@@ -130,7 +135,7 @@ void addEdge(std::vector<std::vector<uint32_t>>& adj, uint32_t a, uint32_t b) {
 }
 
 /** (E3): greedy clusters of the kept nodes, seeds by decreasing maxball. */
-void clusterNodes(const SkeletonGraph& g, Segmentation& s, float alpha) {
+void clusterNodes(const SkeletonGraph& g, Segmentation& s, float alpha, ClusterRule rule) {
     const uint32_t none = std::numeric_limits<uint32_t>::max();
     std::vector<uint32_t> order = s.kept;
     std::stable_sort(order.begin(), order.end(),
@@ -152,9 +157,10 @@ void clusterNodes(const SkeletonGraph& g, Segmentation& s, float alpha) {
                 queued[x] = 1;
                 stack.push_back(x);
             };
+            const float reference = rule == ClusterRule::Seed ? radius : g.maxball[m];
             for (uint32_t nb : s.segmentedAdjacency[m])
                 if (s.kind[nb] != NodeKind::Curvature &&
-                    std::abs(g.maxball[nb] - radius) <= alpha * radius)
+                    std::abs(g.maxball[nb] - reference) <= alpha * radius)
                     push(nb);
             // Every node inside m's maximal ball that the graph reaches from m through the ball.
             std::vector<uint32_t> inside{m}, seen{m};
@@ -164,7 +170,7 @@ void clusterNodes(const SkeletonGraph& g, Segmentation& s, float alpha) {
                 for (uint32_t nb : s.segmentedAdjacency[x]) {
                     if (std::find(seen.begin(), seen.end(), nb) != seen.end()) continue;
                     seen.push_back(nb);
-                    if (glm::length(g.position[nb] - g.position[m]) > g.maxball[m]) continue;
+                    if (!g.inBall(m, g.position[nb])) continue;
                     inside.push_back(nb);
                     push(nb);
                 }
@@ -206,7 +212,7 @@ void pruneCoveredSpurs(SkeletonGraph& g) {
                 branch.push_back(cur);
             }
             if (degree(cur) < 3) continue;  // an isolated line: nothing to prune against
-            if (glm::length(g.position[tip] - g.position[cur]) > g.maxball[cur]) continue;
+            if (!g.inBall(cur, g.position[tip])) continue;
             for (uint32_t b : branch) {
                 removed[b] = 1;
                 mergedInto[b] = cur;
@@ -225,6 +231,7 @@ void pruneCoveredSpurs(SkeletonGraph& g) {
         return newIndex[i];
     };
     SkeletonGraph out;
+    out.metric = g.metric;
     out.prunedNodes = n - kept;
     for (uint32_t i = 0; i < n; ++i) {
         if (removed[i]) continue;
@@ -243,8 +250,24 @@ void pruneCoveredSpurs(SkeletonGraph& g) {
 
 }  // namespace
 
+float SkeletonGraph::ballDistance(uint32_t c, const glm::vec3& x) const {
+    const glm::vec3 d = glm::abs(x - position[c]);
+    return metric == BallMetric::Euclidean ? glm::length(d) : std::max({d.x, d.y, d.z});
+}
+
+float largestNodeSkeletonPercent(const SkeletonGraph& g, uint32_t* node) {
+    if (g.voxelNode.empty()) return 0.0f;
+    std::vector<uint32_t> count(g.position.size(), 0);
+    for (uint32_t v : g.voxelNode)
+        if (v < count.size()) ++count[v];
+    const auto it = std::max_element(count.begin(), count.end());
+    if (node) *node = uint32_t(it - count.begin());
+    return 100.0f * float(*it) / float(g.voxelNode.size());
+}
+
 SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
-                                 const std::vector<float>& maxball, bool pruneSpurs) {
+                                 const std::vector<float>& maxball, bool pruneSpurs,
+                                 BallMetric metric) {
     if (voxels.size() != maxball.size())
         throw Error("skeleton graph: " + std::to_string(voxels.size()) + " voxels but " +
                     std::to_string(maxball.size()) + " radii");
@@ -265,6 +288,7 @@ SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
     // Junction clumps: 26-connected groups of voxels of degree != 2 become one node.
     const uint32_t none = std::numeric_limits<uint32_t>::max();
     SkeletonGraph g;
+    g.metric = metric;
     g.voxelNode.assign(n, none);
     for (uint32_t i = 0; i < n; ++i) {
         if (g.voxelNode[i] != none) continue;
@@ -301,13 +325,13 @@ SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
     return g;
 }
 
-Segmentation segmentSkeleton(const SkeletonGraph& g) {
+Segmentation segmentSkeleton(const SkeletonGraph& g, CoverageSplit split) {
     const uint32_t n = uint32_t(g.position.size());
     Segmentation s;
     s.kind.assign(n, NodeKind::Line);
     std::vector<Piece> pieces = traceLines(g, s.kind);
     splitAtCurvature(g, pieces, s.kind);
-    splitAtCoverage(g, pieces, s.kind);
+    splitAtCoverage(g, pieces, s.kind, split);
 
     s.segmentedNode.resize(n);
     std::iota(s.segmentedNode.begin(), s.segmentedNode.end(), 0u);
@@ -335,7 +359,7 @@ Segmentation segmentSkeleton(const SkeletonGraph& g) {
 
 void clusterSkeleton(const SkeletonGraph& g, Segmentation& s, float alpha,
                      const std::vector<uint8_t>& empty, const GridDims& dims, bool mergeVisible,
-                     GatePlacement placement, float mergeThreshold) {
+                     GatePlacement placement, float mergeThreshold, ClusterRule rule) {
     const uint32_t n = uint32_t(g.position.size());
     if (s.kind.size() != n || s.segmentedNode.size() != n || s.segmentedAdjacency.size() != n)
         throw Error("clusterSkeleton: the segmentation is not of this graph (" +
@@ -346,7 +370,7 @@ void clusterSkeleton(const SkeletonGraph& g, Segmentation& s, float alpha,
                     " voxels in the empty grid, dims hold " + std::to_string(dims.count()));
     s.cluster.assign(n, std::numeric_limits<uint32_t>::max());
     s.clusterCount = 0;
-    clusterNodes(g, s, alpha);
+    clusterNodes(g, s, alpha, rule);
     for (uint32_t i = 0; i < n; ++i)
         if (s.kind[i] == NodeKind::Line) s.cluster[i] = s.cluster[s.segmentedNode[i]];
     s.greedyClusters = s.clusterCount;

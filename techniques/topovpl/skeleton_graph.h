@@ -10,11 +10,13 @@
  *   curvature     (E1) curv(n) = dist(n, chord L1 Lk) / maxball(n); the node of largest
  *                 curv > 1 becomes an extremum, both halves recurse
  *   coverage      (E2) a node outside the maximal balls of both extrema of its line is
- *                 uncovered; the first uncovered node from L1 becomes an extremum, recurse
+ *                 uncovered; the first uncovered node from L1 (or the most uncovered:
+ *                 CoverageSplit) becomes an extremum, recurse
  *   segmented     the kept nodes (topology, curvature, coverage) joined along the former lines;
  *                 every skeleton node maps to the nearer extremum of its piece of line
  *   clusters      (E3) greedy: seeds by maxball descending; a neighbour joins when it is not a
- *                 curvature node and |maxball - R_C| <= alpha R_C; every node inside the
+ *                 curvature node and |maxball - R_C| <= alpha R_C (or the chained reading:
+ *                 ClusterRule); every node inside the
  *                 member's maximal ball and reachable through the graph joins too
  *   merge         (OUR addition, not in the paper; cluster_merge.h) two adjacent clusters merge
  *                 when every pair of kept nodes of their union (each by its voxel and its ball's
@@ -26,8 +28,9 @@
  *                 midpoint, normal along the edge, radius min(maxball) of its ends (both ends'
  *                 radii are kept, for a per-frame radius rule)
  *
- * Positions and radii are in voxel units (voxel centres at integer coordinates + 0.5 are the
- * caller's business: positions here are the voxel indices). Deterministic: ties by node index.
+ * Balls are Euclidean or chessboard cubes (BallMetric). Positions and radii are in voxel units
+ * (voxel centres at integer coordinates + 0.5 are the caller's business: positions here are the
+ * voxel indices). Deterministic: ties by node index.
  */
 #include <cstdint>
 #include <vector>
@@ -40,14 +43,47 @@ namespace gilab::topo {
 
 enum class NodeKind : uint8_t { Line = 0, Topology = 1, Curvature = 2, Coverage = 3 };
 
+/**
+ * How a maximal ball is measured (the paper says "maximal ball" without a metric):
+ *   Euclidean   radius = Euclidean distance to the nearest solid voxel, x in the ball of c iff
+ *               |x - c|_2 <= r
+ *   Chessboard  radius = L-infinity (26-neighbour) distance, the ball a cube: |x - c|_inf <= r
+ *               (the authors' public code measures its distance and opening maps this way)
+ */
+enum class BallMetric : uint8_t { Euclidean = 0, Chessboard = 1 };
+
+/**
+ * E3's radius test, two readings of "does not differ more than alpha % of the maximal radius
+ * contained in the cluster" (R_C, the seed's radius since seeds come largest first):
+ *   Seed     |maxball(nb) - R_C| <= alpha R_C: every member within alpha of the seed
+ *   Chained  |maxball(nb) - maxball(m)| <= alpha R_C: a neighbour within alpha of the member m
+ *            that reaches it, so radii may drift along a cluster
+ */
+enum class ClusterRule : uint8_t { Seed = 0, Chained = 1 };
+
+/** E2's split point on a line with uncovered nodes: the first from L1 (as printed: "the same
+ *  procedure", read in order) or the most uncovered (largest distance outside both extrema's
+ *  balls, the way E1 takes the most curved). */
+enum class CoverageSplit : uint8_t { First = 0, Most = 1 };
+
 /** The skeleton as a graph (one node per skeleton voxel, clumps collapsed). */
 struct SkeletonGraph {
     std::vector<glm::vec3> position;  // voxel coordinates (a clump: the mean)
     std::vector<float> maxball;       // maximal-ball radius in voxels
     std::vector<std::vector<uint32_t>> adjacency;
-    std::vector<uint32_t> voxelNode;  // per skeleton voxel (input order): its node
-    uint32_t prunedNodes = 0;         // nodes removed with covered spurs
+    std::vector<uint32_t> voxelNode;            // per skeleton voxel (input order): its node
+    uint32_t prunedNodes = 0;                   // nodes removed with covered spurs
+    BallMetric metric = BallMetric::Euclidean;  // how maxball is measured (set-up only)
+
+    /** Is point x inside the maximal ball of node c (in this graph's metric)? */
+    bool inBall(uint32_t c, const glm::vec3& x) const { return ballDistance(c, x) <= maxball[c]; }
+    /** |x - position[c]| in this graph's metric. */
+    float ballDistance(uint32_t c, const glm::vec3& x) const;
 };
+
+/** Voxels per skeleton node: the largest node's share of the skeleton voxels, in percent (a
+ *  clump of empty space that did not thin, e.g. open sky, shows as one node holding much). */
+float largestNodeSkeletonPercent(const SkeletonGraph& graph, uint32_t* node = nullptr);
 
 /**
  * Builds the graph from skeleton voxels (x, y, z) and their maximal-ball radii. With
@@ -57,7 +93,8 @@ struct SkeletonGraph {
  * filter of the paper's thinning (Chaussard et al. 2013), which our thinning does not have.
  */
 SkeletonGraph buildSkeletonGraph(const std::vector<glm::ivec3>& voxels,
-                                 const std::vector<float>& maxball, bool pruneCoveredSpurs = true);
+                                 const std::vector<float>& maxball, bool pruneCoveredSpurs = true,
+                                 BallMetric metric = BallMetric::Euclidean);
 
 struct Gate {
     glm::vec3 centre{0.0f};
@@ -100,7 +137,8 @@ struct Segmentation {
 
 /** Segments the graph: lines, curvature (E1) and coverage (E2) nodes, the segmented edges and
  *  every node's kept node. Clusters and gates are left empty (clusterSkeleton). */
-Segmentation segmentSkeleton(const SkeletonGraph& graph);
+Segmentation segmentSkeleton(const SkeletonGraph& graph,
+                             CoverageSplit split = CoverageSplit::First);
 
 /**
  * Clusters a segmentation (E3) with tolerance alpha (0.2 = the paper's 20 %); with
@@ -112,8 +150,8 @@ Segmentation segmentSkeleton(const SkeletonGraph& graph);
  */
 void clusterSkeleton(const SkeletonGraph& graph, Segmentation& s, float alpha,
                      const std::vector<uint8_t>& empty, const GridDims& dims, bool mergeVisible,
-                     GatePlacement placement = GatePlacement::Midpoint,
-                     float mergeThreshold = 1.0f);
+                     GatePlacement placement = GatePlacement::Midpoint, float mergeThreshold = 1.0f,
+                     ClusterRule rule = ClusterRule::Seed);
 
 /** segmentSkeleton then clusterSkeleton without the merge: the paper's literal clusters. */
 Segmentation segmentSkeleton(const SkeletonGraph& graph, float alpha);

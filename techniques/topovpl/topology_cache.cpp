@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -25,13 +26,14 @@ namespace fs = std::filesystem;
 
 // A field added to one of these must be serialized below (and kTopologyFormatVersion bumped); a
 // new setting must be hashed in topologyKey. The sizes are those of x86-64 / AArch64.
-static_assert(sizeof(TopologySettings) == 16, "hash the new setting in topologyKey");
+static_assert(sizeof(TopologySettings) == 20, "hash the new setting in topologyKey");
 static_assert(sizeof(SkeletonGraph) == 104, "serialize the new SkeletonGraph field");
+static_assert(offsetof(SkeletonGraph, metric) == 100, "serialize the new SkeletonGraph field");
 static_assert(sizeof(Gate) == 48, "serialize the new Gate field");
 // Segmentation::pieces (24 bytes) is set-up only and deliberately not stored.
 static_assert(sizeof(Segmentation) == 192, "serialize the new Segmentation field");
 static_assert(sizeof(WorldGate) == 48, "serialize the new WorldGate field");
-static_assert(sizeof(SceneTopology) == 392, "serialize the new SceneTopology field");
+static_assert(sizeof(SceneTopology) == 400, "serialize the new SceneTopology field");
 
 constexpr char kMagic[8] = {'G', 'I', 'L', 'A', 'B', 'T', 'O', 'P'};
 constexpr size_t kChecksumBytes = 16;
@@ -352,6 +354,7 @@ std::string serialize(const std::string& key, const SceneTopology& t) {
     w.u32(t.skeletonVoxels);
     w.u32(t.emptyVoxels);
     w.u32(t.solidVoxels);
+    w.u64(t.anchoredVoxels);
 
     const SkeletonGraph& g = t.graph;
     w.vec3Array(g.position);
@@ -359,6 +362,7 @@ std::string serialize(const std::string& key, const SceneTopology& t) {
     w.lists(g.adjacency);
     w.u32Array(g.voxelNode);
     w.u32(g.prunedNodes);
+    w.u8(uint8_t(g.metric));
 
     const Segmentation& s = t.segmentation;
     w.u64(s.kind.size());
@@ -414,6 +418,7 @@ SceneTopology deserialize(std::string_view data, const std::string& key) {
     t.skeletonVoxels = r.u32("voxel counts");
     t.emptyVoxels = r.u32("voxel counts");
     t.solidVoxels = r.u32("voxel counts");
+    t.anchoredVoxels = r.u64("anchored voxels");
 
     SkeletonGraph& g = t.graph;
     g.position = r.vec3Array("graph.position");
@@ -421,6 +426,10 @@ SceneTopology deserialize(std::string_view data, const std::string& key) {
     g.adjacency = r.lists("graph.adjacency");
     g.voxelNode = r.u32Array("graph.voxelNode");
     g.prunedNodes = r.u32("graph.prunedNodes");
+    const uint8_t metric = r.u8("graph.metric");
+    if (metric > uint8_t(BallMetric::Chessboard))
+        corrupt("graph.metric = " + std::to_string(metric) + " is not a ball metric");
+    g.metric = BallMetric(metric);
 
     Segmentation& s = t.segmentation;
     s.kind.resize(r.count("segmentation.kind", 1));
@@ -469,7 +478,12 @@ std::string topologyKey(const Scene& scene, const TopologySettings& settings) {
     w.u8(settings.mergeVisible ? 1 : 0);
     w.u8(uint8_t(settings.gatePlacement));
     w.f32(settings.mergeVisibility);
+    w.u8(uint8_t(settings.clusterRule));
+    w.u8(uint8_t(settings.ballMetric));
+    w.u8(uint8_t(settings.coverageSplit));
+    w.u8(uint8_t(settings.skeletonFilter));
     w.f32(VoxelGrid::kDefaultMargin);  // buildSceneTopology fits the grid with it
+    w.u32(uint32_t(kBoundsMarginVoxels));
     w.text("bounds");
     w.vec3(scene.caps.bounds.lo);
     w.vec3(scene.caps.bounds.hi);

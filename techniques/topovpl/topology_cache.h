@@ -41,11 +41,14 @@ struct Scene;
 namespace topo {
 
 /** The file layout above; bump it with any change to the layout or to SceneTopology's fields. */
-inline constexpr int kTopologyFormatVersion = 3;  // 2: gate end radii, greedyClusters; 3: neck
+inline constexpr int kTopologyFormatVersion = 4;  // 2: gate end radii, greedyClusters; 3: neck;
+                                                  // 4: anchored voxels, ball metric
 /** Bump when the pipeline (voxelization, distance transform, thinning, graph, segmentation,
  *  clustering, nearest node, VoxelGrid placement) changes its output: every key changes, so old
  *  entries are never read again. */
-inline constexpr int kTopologyAlgorithmVersion = 3;  // 2: visibility merge; 3: gate placement
+// 2: visibility merge; 3: gate placement; 4: closed at the scene's bounds, E2/E3 readings,
+// ball metric, lifespan filter
+inline constexpr int kTopologyAlgorithmVersion = 4;
 
 /** 32 lower-case hex digits; see the header comment for what is hashed. Throws gilab::Error
  *  naming the scene when a triangle's material or a material's texture is out of range. */

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "core/passes/shadow_maps.h"
@@ -36,6 +37,11 @@ topo::TopologySettings topologySettings(const TopovplSettings& s) {
     t.mergeVisibility = s.mergeVisibility;
     t.gatePlacement =
         s.gateAtBottleneck ? topo::GatePlacement::Bottleneck : topo::GatePlacement::Midpoint;
+    t.clusterRule = s.chainedClusters ? topo::ClusterRule::Chained : topo::ClusterRule::Seed;
+    t.ballMetric = s.chessboardBalls ? topo::BallMetric::Chessboard : topo::BallMetric::Euclidean;
+    t.coverageSplit = s.splitMostUncovered ? topo::CoverageSplit::Most : topo::CoverageSplit::First;
+    t.skeletonFilter =
+        s.lifespanFilter ? topo::SkeletonFilter::Lifespan : topo::SkeletonFilter::SpurPrune;
     return t;
 }
 
@@ -195,6 +201,25 @@ void TopovplTechnique::setup(TechniqueContext& ctx) {
     if (s.visibility == TopoVisibility::SameClusterOnly || t.gates.empty())
         ctx.skip("gate lighting", t.gates.empty() ? "the topology has no gates (one cluster)"
                                                   : "visibility = same_cluster");
+    // A node holding much of the skeleton is empty space that did not thin (issue 30: open sky
+    // collapsed into one clump before the bounds closed the empty space).
+    uint32_t node = 0;
+    const float largest = topo::largestNodeSkeletonPercent(t.graph, &node);
+    ctx.stat("largest_node_skeleton_percent", largest);
+    // A tiny skeleton (closed rooms thin to a voxel each) is not a clump: ask for many voxels.
+    const double voxels = double(largest) / 100.0 * double(t.graph.voxelNode.size());
+    if (largest > 1.0f && voxels > 64.0) {
+        const std::string text =
+            "warning: skeleton node " + std::to_string(node) + " holds " +
+            std::to_string(int64_t(voxels)) + " voxels, " + std::to_string(largest) +
+            " % of the skeleton (> 1 %): a clump of empty space that did not thin (a solid "
+            "standing free in the empty space?), whose cluster will take many VPLs";
+        ctx.note(text);
+        std::fprintf(stderr, "gilab: topovpl: %s\n", text.c_str());
+    }
+    if (t.anchoredVoxels > 0)
+        ctx.note("lifespan filter: " + std::to_string(t.anchoredVoxels) +
+                 " skeleton voxels anchored by lifespan > opening - distance");
     ctx.stat("visibility_clusters", t.segmentation.clusterCount);
     ctx.stat("gates", double(t.gates.size()));
     ctx.stat("skeleton_voxels", t.skeletonVoxels);
@@ -272,8 +297,15 @@ void TopovplTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameT
                                       : topo::LaMode::Unshadowed;
         g.lighting->recordLa(cmd, mode, s.farClusterOnly);
     }
-    PassScope pass(ctx, cmd, "il");
-    g.lighting->recordIl(cmd, targets.indirect, s.clampDistance * g.diagonal);
+    {
+        PassScope pass(ctx, cmd, "il");
+        g.lighting->recordIl(cmd, targets.indirect, s.clampDistance * g.diagonal);
+    }
+    if (s.sameClusterStat) {
+        // Not part of the method: a diagnostic, left out of the frame's GPU time (docs/timing.md).
+        PassScope pass(ctx, cmd, "diag.same_cluster_share");
+        g.lighting->recordSameClusterShare(cmd, s.clampDistance * g.diagonal);
+    }
 }
 
 void TopovplTechnique::frameFinished(TechniqueContext& ctx) {
@@ -286,6 +318,11 @@ void TopovplTechnique::frameFinished(TechniqueContext& ctx) {
     ctx.stat("la_overflow_entries", double(st.overflow));
     ctx.stat("valid_vpls", st.validVpls);
     ctx.stat("vpls_without_cluster", st.vplsWithoutCluster);
+    if (m_settings.sameClusterStat) {
+        const double all = st.unshadowedRadiance;
+        ctx.stat("same_cluster_unshadowed_percent",
+                 all > 0.0 ? 100.0 * st.sameClusterRadiance / all : 0.0);
+    }
     if (st.overflow > 0)
         ctx.note("light assignment overflow: " + std::to_string(st.overflow) + " of " +
                  std::to_string(st.entries) +

@@ -28,6 +28,24 @@ std::vector<ParamSpec> topovplParamSpecs() {
                   "bottleneck: a gate at the narrowest node of its skeleton line, the doorway "
                   "(ours) | midpoint: at the segmented edge's midpoint (E4 as printed)",
                   kRebuild),
+        enumParam("cluster_rule", "chained", {"chained", "seed"},
+                  "E3's radius test: chained: |maxball(nb) - maxball(m)| <= alpha R_C, within "
+                  "alpha of the member that reaches it (default) | seed: |maxball(nb) - R_C| "
+                  "<= alpha R_C, every member within alpha of the cluster's largest ball",
+                  kRebuild),
+        enumParam("ball_metric", "euclidean", {"euclidean", "chessboard"},
+                  "maximal balls (radii, E2 coverage, E3 ball traversal, spur pruning): "
+                  "euclidean | chessboard: L-infinity cubes, as the authors' public code",
+                  kRebuild),
+        enumParam("coverage_split", "first", {"first", "most"},
+                  "E2: split a line at its first uncovered node from L1 | at the most uncovered "
+                  "one",
+                  kRebuild),
+        enumParam("skeleton_filter", "lifespan", {"lifespan", "spur_prune"},
+                  "lifespan: the authors' thinning filter, keep a curve voxel iff its lifespan "
+                  "exceeds opening - distance (chessboard; default) | spur_prune: prune end "
+                  "branches inside their junction's ball (ours, the default before issue 30)",
+                  kRebuild),
         enumParam("topology_cache", "on", {"on", "off"},
                   "reuse the precomputed topology from results/cache/topology ($GILAB_CACHE)",
                   kRebuild),
@@ -61,6 +79,9 @@ std::vector<ParamSpec> topovplParamSpecs() {
                   "(paper: min)"),
         floatParam("gate_radius_scale", 1.0, 0.0, 100.0, "",
                    "multiplies the gate radius (> 1: oversized disks, §VI-B)"),
+        enumParam("same_cluster_stat", "on", {"on", "off"},
+                  "diagnostic pass diag.same_cluster_share (not in the frame time): the share of "
+                  "the unshadowed VPL light that same-cluster pairs carry"),
     };
 }
 
@@ -71,6 +92,10 @@ TopovplSettings topovplSettingsFrom(const ParamSet& p) {
     s.mergeVisible = p.getEnum("cluster_merge") == "visible";
     s.gateAtBottleneck = p.getEnum("gate_placement") == "bottleneck";
     s.mergeVisibility = float(p.getFloat("merge_visibility"));
+    s.chainedClusters = p.getEnum("cluster_rule") == "chained";
+    s.chessboardBalls = p.getEnum("ball_metric") == "chessboard";
+    s.splitMostUncovered = p.getEnum("coverage_split") == "most";
+    s.lifespanFilter = p.getEnum("skeleton_filter") == "lifespan";
     s.useCache = p.getEnum("topology_cache") == "on";
     s.vpls = uint32_t(p.getInt("vpls"));
     s.rsmResolution = uint32_t(p.getInt("rsm_resolution"));
@@ -90,6 +115,7 @@ TopovplSettings topovplSettingsFrom(const ParamSet& p) {
                    : rule == "mean" ? GateRadiusRule::Mean
                                     : GateRadiusRule::Max;
     s.gateRadiusScale = float(p.getFloat("gate_radius_scale"));
+    s.sameClusterStat = p.getEnum("same_cluster_stat") == "on";
     if (s.tileSize != 8 && s.tileSize != 16 && s.tileSize != 32)
         throw Error("topovpl: tile_size = " + std::to_string(s.tileSize) +
                     " must be 8, 16 or 32 (the local sort holds one power-of-two tile in "

@@ -16,11 +16,15 @@ enum class GateRadiusRule { Min, Mean, Max, Neck };
 
 struct TopovplSettings {
     // Set-up (Rebuild): the topology and the buffers.
-    uint32_t voxelResolution = 256;  // §VI-A
-    float alphaPercent = 20.0f;      // E3, §IV-B-2
-    bool mergeVisible = true;        // our merge of mutually visible clusters (docs)
-    bool gateAtBottleneck = true;    // ours; false: E4's edge midpoint
-    float mergeVisibility = 1.0f;    // share of mutually visible ball samples to merge
+    uint32_t voxelResolution = 256;   // §VI-A
+    float alphaPercent = 20.0f;       // E3, §IV-B-2
+    bool mergeVisible = true;         // our merge of mutually visible clusters (docs)
+    bool gateAtBottleneck = true;     // ours; false: E4's edge midpoint
+    float mergeVisibility = 1.0f;     // share of mutually visible ball samples to merge
+    bool chainedClusters = true;      // E3: |r_nb - r_m| <= alpha R_C; false: |r_nb - R_C|
+    bool chessboardBalls = false;     // maximal balls in L-infinity (cubes); false: Euclidean
+    bool splitMostUncovered = false;  // E2: split at the most uncovered node; false: the first
+    bool lifespanFilter = true;       // the authors' thinning filter; false: our spur pruning
     bool useCache = true;
     uint32_t vpls = 1024;  // Table I: 512, 1024, 2048
     uint32_t rsmResolution = 512;
@@ -34,6 +38,7 @@ struct TopovplSettings {
     bool farClusterOnly = false;
     GateRadiusRule gateRadius = GateRadiusRule::Neck;
     float gateRadiusScale = 1.0f;
+    bool sameClusterStat = true;  // diagnostic pass: same-cluster share of the unshadowed light
 };
 
 std::vector<ParamSpec> topovplParamSpecs();
