@@ -505,6 +505,44 @@ TEST_F(GpuRunner, ShardsAreDisjointAndCoverEveryRun) {
 // metrics.same_vpl_reference: a VPL technique's run also gets Table II (Noël & Biri 2014)
 // against its own VPLs with exact shadow rays; other techniques do not. With the door closed
 // the gates let nothing into room B, as the shadow rays: MSE 0; the unshadowed VPLs leak.
+// Noisy frame times get more frames (docs/timing.md 5): with a target IQR of 0 every run times
+// up to max_frames (unless its frames are identical); with a loose target it stops at "frames".
+// The record says how many frames, the spread and whether it stayed noisy.
+TEST_F(GpuRunner, NoisyFrameTimesGetMoreFramesUpToTheLimit) {
+    for (const double target : {0.0, 10.0}) {
+        SCOPED_TRACE(target);
+        nlohmann::json j = baseConfig();
+        j["name"] = target == 0.0 ? "tight" : "loose";
+        j["timing"] = {{"warmup", 0}, {"frames", 4}, {"target_iqr", target}, {"max_frames", 7}};
+        j["techniques"] = {{{"technique", "direct"}}};
+        std::ofstream(m_config) << j.dump(2);
+        const RunnerSummary s = runExperiment(options());
+        ASSERT_EQ(s.ran, 1u);
+        const nlohmann::json r = RunStore(s.dir).loadFinished().at(0);
+        const nlohmann::json& t = r["timing"];
+        const int frames = t["timed_frames"].get<int>();
+        const double spread = t["iqr_over_median"].get<double>();
+        EXPECT_EQ(t["frames_requested"], 4);
+        EXPECT_EQ(t["frame_gpu_ms"]["samples"].size(), size_t(frames));
+        EXPECT_NEAR(
+            spread,
+            t["frame_gpu_ms"]["iqr"].get<double>() / t["frame_gpu_ms"]["median"].get<double>(),
+            1e-9);
+        if (target == 0.0) {
+            EXPECT_TRUE(frames == 7 || spread == 0.0) << frames << " " << spread;
+            EXPECT_EQ(t["noisy"].get<bool>(), spread > 0.0);
+        } else {
+            EXPECT_EQ(frames, 4);
+            EXPECT_FALSE(t["noisy"].get<bool>());
+        }
+    }
+    // max_frames below frames is refused.
+    nlohmann::json bad = baseConfig();
+    bad["timing"] = {{"frames", 5}, {"max_frames", 4}};
+    EXPECT_NE(parseError(bad).find("\"timing.max_frames\": must be at least"), std::string::npos)
+        << parseError(bad);
+}
+
 TEST_F(GpuRunner, SameVplReferenceGivesTableIIForVplTechniques) {
     nlohmann::json j = baseConfig();
     j["name"] = "same_vpl";

@@ -23,9 +23,11 @@
 
 #include "core/params/params.h"
 #include "core/scene/scene_loader.h"
+#include "core/technique/frame_harness.h"
 #include "core/technique/registry.h"
 #include "core/util/error.h"
 #include "core/util/json_reader.h"
+#include "experiments/cli/cli.h"
 #include "experiments/runner/experiment_config.h"
 
 namespace gilab {
@@ -186,6 +188,41 @@ TEST(CpuInputErrors, ExperimentDuplicateKeyNamesKeyAndFile) {
                 {path + ":3:3", "duplicate key \"name\""});
 }
 
+// Deep nesting (issue 31): 100,000 nested arrays once ran out of memory (each open container
+// kept its full key path: memory grew with the square of the depth). Now a clear error naming
+// the file, line and column, quickly, for scenes and experiments alike; 256 levels still parse.
+TEST(CpuInputErrors, DeepNestingIsRefusedWithTheFileNotAnAllocationFailure) {
+    TempDir dir;
+    const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+    const std::string scene = dir.write("deep_scene.json", "{\"camera\": " + deep + "}");
+    const auto t0 = std::chrono::steady_clock::now();
+    expectError([&] { loadScene(scene); }, {scene + ":1:", "nested more than 256 levels"});
+    const std::string config = dir.write("deep_config.json", "{\"scenes\": " + deep + "}");
+    expectError([&] { exp::loadExperimentConfig(config); },
+                {config + ":1:", "nested more than 256 levels"});
+    EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 2.0);
+    const std::string ok = std::string(255, '[') + "1" + std::string(255, ']');
+    nlohmann::json j = parseJsonText("{\"a\": " + ok.substr(1, ok.size() - 2) + "}", "ok.json");
+    size_t depth = 1;  // the object
+    for (const nlohmann::json* v = &j["a"]; v->is_array(); v = &(*v)[0])
+        ++depth;
+    EXPECT_EQ(depth, 255u);
+    // Error paths still name the key inside arrays.
+    expectError([&] { parseJsonText(R"({"a": [{"b": 1, "b": 2}]})", "p.json"); },
+                {"p.json:1:", "duplicate key \"a[0].b\""});
+}
+
+// A description whose glTF data is missing (the shared scenes live outside the repository) says
+// where it expected the data and where to read how to get it.
+TEST(CpuInputErrors, MissingSceneDataNamesTheFolderAndTheScenesReadme) {
+    TempDir dir;
+    const std::string scene =
+        dir.write("outside.json", R"({"gltf": "../no_shared/scenes/sponza/sponza.gltf"})");
+    expectError([&] { loadScene(scene); }, {scene, "\"gltf\"", "sponza.gltf: glTF file not found",
+                                            "not part of the repository", "no_shared/scenes/sponza",
+                                            "(no such folder)", "scenes/README.md"});
+}
+
 TEST(CpuInputErrors, ParseJsonTextKeepsValidDocuments) {
     const nlohmann::json j = parseJsonText(
         R"({"a": [1, -2, 3.5, 1e-999, 18446744073709551615], "b": {"": null, "c": "\"x\""},
@@ -281,6 +318,23 @@ TEST(CpuInputErrors, SweepCountsBeyondTheCeilingAndBeyond64BitsAreRefused) {
                 {"overflow.json", "more than 18446744073709551615 runs", "max_runs"});
 }
 
+// "max_runs" allows up to 1e8, but a plan that would not fit in memory is refused at once with
+// what it needs (issue 31: 1,000,000 runs died after 76 s with a raw std::bad_alloc).
+TEST(CpuInputErrors, PlansBeyondTheMachinesMemoryAreRefusedWithTheirSize) {
+    nlohmann::json j = sweepConfig(1000, 1000);  // 1e6 a scene
+    j["scenes"] = nlohmann::json::array();
+    for (int i = 0; i < 64; ++i)  // 6.4e7 runs x 16 KiB = 977 GiB
+        j["scenes"].push_back({{"scene", "builtin"}, {"label", "s" + std::to_string(i)}});
+    j["max_runs"] = 100000000;
+    const auto start = std::chrono::steady_clock::now();
+    const std::string message = expectError([&] { exp::parseExperimentConfig(j, "mem.json", "."); },
+                                            {"mem.json", "64000000 runs", "whose plan needs about",
+                                             "GiB", "of this machine's memory", "runs fit"});
+    EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::seconds(5));
+    std::printf("%s\n", message.c_str());
+    EXPECT_GT(exp::planningMemoryBudget(), size_t(0));
+}
+
 TEST(CpuInputErrors, MaxRunsRaisesAndLowersTheLimit) {
     nlohmann::json j = sweepConfig(10, 20);  // 200 runs
     EXPECT_EQ(exp::expandRuns(exp::parseExperimentConfig(j, "ok.json", ".")).size(), 200u);
@@ -300,6 +354,27 @@ TEST(CpuInputErrors, MaxRunsRaisesAndLowersTheLimit) {
     EXPECT_EQ(exp::countRuns(c, 50), 50u);
 }
 
+// --set given twice for one key: refused (it silently kept the last value; issue 31).
+TEST(CpuInputErrors, SetTwiceForOneKeyIsRefused) {
+    ParamSet technique = TechniqueRegistry::instance().defaultParams("input_errors_probe");
+    ParamSet shared = defaultSharedParams();
+    expectError(
+        [&] {
+            cli::applyAssignments({"count=2", "count=3"}, technique, shared);
+        },
+        {"--set count=3", "\"count\" is already set by --set count=2"});
+    expectError(
+        [&] {
+            cli::applyAssignments(
+                {"shared.shadow_constant_bias=0.1", "shared.shadow_constant_bias=0.2"}, technique,
+                shared);
+        },
+        {"already set by --set shared.shadow_constant_bias=0.1"});
+    // Distinct keys still work, and a technique key and the shared key of one name are distinct.
+    cli::applyAssignments({"count=2", "scale=0.5"}, technique, shared);
+    EXPECT_EQ(technique.getInt("count"), 2);
+}
+
 // --- 5. Signals -------------------------------------------------------------------------------
 
 /** The gilab binary next to this test's folder (build/tests/.. = build), or "" if absent. */
@@ -316,6 +391,30 @@ std::string readText(const fs::path& path) {
     std::stringstream s;
     s << in.rdbuf();
     return s.str();
+}
+
+// `gilab render` of an animated scene says that it draws frame 0 and points to `gilab run` (it
+// rendered frame 0 without a word; issue 31).
+TEST(GpuRenderCommand, AnAnimatedSceneSaysItDrawsFrameZero) {
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    TempDir dir;
+    const std::string command = gilab + " render --scene " + GILAB_SOURCE_DIR +
+                                "/scenes/cornell_box.json#spot_orbit --resolution 16x16 "
+                                "--warmup 0 --frames 1 -q --out " +
+                                (dir.path() / "out").string() + " 2>&1";
+    FILE* pipe = ::popen(command.c_str(), "r");
+    ASSERT_NE(pipe, nullptr);
+    std::string output;
+    char buffer[4096];
+    while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe))
+        output.append(buffer, n);
+    EXPECT_EQ(::pclose(pipe), 0) << output;
+    EXPECT_NE(output.find("animated scene (9 frames): render draws its frame 0"), std::string::npos)
+        << output;
+    EXPECT_NE(output.find("`gilab run`"), std::string::npos) << output;
+    EXPECT_NE(readText(dir.path() / "out" / "result.json").find("render draws its frame 0"),
+              std::string::npos);
 }
 
 struct Interrupted {

@@ -111,6 +111,20 @@ Scene buildScene(const SceneDescription& d) {
         }
     } else {
         gltf::LoadResult loaded;
+        std::error_code ec;
+        if (!std::filesystem::is_regular_file(d.gltfPath, ec)) {
+            // Shipped descriptions refer to scene data kept outside the repository (issue 31: a
+            // fresh clone could not load Sponza and was not told where to get it).
+            const std::filesystem::path folder = std::filesystem::path(d.gltfPath).parent_path();
+            throw Error(d.context + ": \"gltf\": " + d.gltfPath +
+                        ": glTF file not found. The scene's data is not part of the repository: "
+                        "put it in " +
+                        folder.string() +
+                        (std::filesystem::is_directory(folder, ec) ? " (the folder exists)"
+                                                                   : " (no such folder)") +
+                        "; scenes/README.md lists each scene's public source, licence and "
+                        "conversion steps");
+        }
         try {
             loaded = gltf::loadFile(d.gltfPath);
         } catch (const Error& e) {  // name the description that refers to the glTF too

@@ -80,7 +80,7 @@ public:
         Frame& f = m_stack.back();
         if (f.value->contains(k)) {
             duplicate = true;
-            duplicatePath = join(f.path, k);
+            duplicatePath = join(containerPath(), k);
             return false;
         }
         f.key = std::move(k);
@@ -96,12 +96,11 @@ public:
         return false;
     }
 
-    /** The key path of the value about to be read ("" at the document root). */
+    /** The key path of the value about to be read ("" at the document root). Built from the
+     *  frames' own segments on demand (errors only), so memory stays linear in the depth. */
     std::string currentPath() const {
         if (m_stack.empty()) return "";
-        const Frame& f = m_stack.back();
-        if (f.value->is_array()) return f.path + "[" + std::to_string(f.value->size()) + "]";
-        return join(f.path, f.key);
+        return join(containerPath(), segmentOfNext(m_stack.back()));
     }
 
     bool duplicate = false;
@@ -109,16 +108,35 @@ public:
     size_t errorPosition = 0;
     std::string errorToken, errorMessage, errorPath;
     int errorId = 0;
+    bool tooDeep = false;
+
+    /** Containers nest at most this deep: far beyond any scene or experiment (they use < 10), and
+     *  short of what recursive readers of the document could take. */
+    static constexpr size_t kMaxDepth = 256;
 
 private:
     struct Frame {
         json* value;
-        std::string path;  // of this container
-        std::string key;   // objects: the key of the value being read
+        std::string segment;  // how its parent names it: "key" or "[i]" ("" at the root)
+        std::string key;      // objects: the key of the value being read
     };
 
-    static std::string join(const std::string& path, const std::string& key) {
-        return path.empty() ? key : path + "." + key;
+    /** "key" of the next value of an object, "[i]" of an array. */
+    static std::string segmentOfNext(const Frame& f) {
+        return f.value->is_array() ? "[" + std::to_string(f.value->size()) + "]" : f.key;
+    }
+
+    static std::string join(const std::string& path, const std::string& segment) {
+        if (path.empty() || segment.empty() || segment[0] == '[') return path + segment;
+        return path + "." + segment;
+    }
+
+    /** The path of the innermost open container. */
+    std::string containerPath() const {
+        std::string path;
+        for (const Frame& f : m_stack)
+            path = join(path, f.segment);
+        return path;
     }
 
     json* place(json&& v) {
@@ -137,9 +155,13 @@ private:
     }
 
     bool open(json&& container) {
-        std::string path = currentPath();
+        if (m_stack.size() >= kMaxDepth) {
+            tooDeep = true;
+            return false;
+        }
+        std::string segment = m_stack.empty() ? std::string() : segmentOfNext(m_stack.back());
         json* value = place(std::move(container));
-        m_stack.push_back({value, std::move(path), {}});
+        m_stack.push_back({value, std::move(segment), {}});
         return true;
     }
 
@@ -205,6 +227,12 @@ nlohmann::json parseJsonText(const std::string& text, const std::string& context
         throw Error(location(text, context, at) + ": duplicate key \"" + builder.duplicatePath +
                     "\" (each key may appear once per object; JSON parsers disagree on which " +
                     "copy wins)");
+    }
+    if (builder.tooDeep) {
+        const size_t at = consumed > 0 ? consumed - 1 : 0;
+        throw Error(location(text, context, at) + ": arrays and objects nested more than " +
+                    std::to_string(StrictDomBuilder::kMaxDepth) +
+                    " levels deep (a scene or an experiment needs fewer than 10)");
     }
     if (builder.errorId == 406) {  // a number beyond the range of a double
         const size_t start = builder.errorPosition >= builder.errorToken.size()

@@ -110,7 +110,9 @@ void checkInputs(const LoadedImage& test, const LoadedImage& ref) {
     }
     if (test.image.width() != ref.image.width() || test.image.height() != ref.image.height()) {
         throw Error("size mismatch: test " + quoted(test.argument) + " is " + sizeText(test.image) +
-                    ", reference " + quoted(ref.argument) + " is " + sizeText(ref.image));
+                    ", reference " + quoted(ref.argument) + " is " + sizeText(ref.image) +
+                    " (render both at one size: `gilab render` and `gilab reference` take "
+                    "--resolution WxH)");
     }
 }
 

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include "core/image/image_io.h"
@@ -21,9 +22,15 @@ namespace gilab::cli {
 
 void applyAssignments(const std::vector<std::string>& assignments, ParamSet& technique,
                       ParamSet& shared) {
+    std::map<std::string, std::string> seen;  // key -> its first assignment
     for (const std::string& a : assignments) {
         try {
             auto [key, value] = splitAssignment(a);
+            // Two values for one key: refused, not "the last wins" silently (issue 31).
+            const auto [it, first] = seen.emplace(key, a);
+            if (!first)
+                throw UsageError("--set " + a + ": \"" + key + "\" is already set by --set " +
+                                 it->second + " (give each parameter once)");
             if (key.rfind("shared.", 0) == 0)
                 shared.set(key.substr(7), value);
             else
@@ -72,6 +79,14 @@ int runRender(const RenderOptions& options) {
     Progress::setQuiet(options.quiet);
     Scene scene = loadSceneOrDefault(options.scenePath);
     applyResolutionOverride(scene, options.resolution);
+    // `render` draws one static frame; an animated scene's sequence is `gilab run`'s (issue 31:
+    // it used to render frame 0 without a word).
+    if (scene.animation.animated())
+        scene.warnings.push_back(
+            "animated scene (" + std::to_string(scene.animation.frameCount) +
+            " frames): render draws its frame 0 (t = 0) as a static frame; `gilab run` with an "
+            "experiment of this scene renders the sequence and times the dynamic frames "
+            "(docs/scenes.md, \"Animation\")");
     for (const std::string& w : scene.warnings)
         std::fprintf(stderr, "gilab: %s: warning: %s\n", scene.name.c_str(), w.c_str());
 

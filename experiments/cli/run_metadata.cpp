@@ -1,6 +1,7 @@
 #include "experiments/cli/run_metadata.h"
 
 #include <unistd.h>
+#include <limits>
 
 #include <algorithm>
 #include <cmath>
@@ -70,6 +71,19 @@ nlohmann::ordered_json summaryJson(const std::vector<double>& values) {
 bool isDiagnosticPass(const std::string& name) {
     const size_t slash = name.find('/');
     return name.compare(slash == std::string::npos ? 0 : slash + 1, 5, "diag.") == 0;
+}
+
+double frameGpuIqrOverMedian(const std::vector<FrameTiming>& frames) {
+    if (frames.size() < 4) return std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> total;
+    for (const FrameTiming& f : frames) {
+        std::vector<const vk::PassTime*> list;
+        for (const vk::PassTime& p : f.passes)
+            list.push_back(&p);
+        total.push_back(topLevelGpuMs(list));
+    }
+    const Summary s = summarize(total);
+    return s.median > 0.0 ? s.iqr() / s.median : std::numeric_limits<double>::quiet_NaN();
 }
 
 std::string isoDateUtc() {

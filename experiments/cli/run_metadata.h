@@ -22,6 +22,9 @@ nlohmann::ordered_json provenanceJson(const std::string& commandLine);
 /** A diagnostic pass, "<technique>/diag.<name>": it measures the method, is timed, and is left
  *  out of the frame's GPU time (docs/timing.md). */
 bool isDiagnosticPass(const std::string& name);
+/** The frames' GPU time (top-level passes, diagnostics left out): IQR / median, NaN for fewer
+ *  than 4 frames or a zero median. */
+double frameGpuIqrOverMedian(const std::vector<FrameTiming>& frames);
 nlohmann::ordered_json deviceJson(const vk::Context& ctx);
 nlohmann::ordered_json sceneToJson(const Scene& scene);
 /** Setup times, the warm-up, then per-frame CPU and per-pass GPU times as median / IQR over the

@@ -1,5 +1,9 @@
 #include "experiments/runner/experiment_config.h"
 
+#include <unistd.h>
+
+#include <cstdio>
+
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
@@ -356,9 +360,16 @@ ExperimentConfig parseExperimentConfig(const nlohmann::json& json, const std::st
     c.reference = parseReference(root["reference"]);
     if (root.has("timing")) {
         const JsonNode t = root["timing"];
-        t.expectKeys({"warmup", "frames"});
+        t.expectKeys({"warmup", "frames", "target_iqr", "max_frames"});
         if (t.has("warmup")) c.timing.warmupFrames = t["warmup"].integerIn(0, 1000);
         if (t.has("frames")) c.timing.timedFrames = t["frames"].integerIn(1, 100000);
+        if (t.has("target_iqr")) c.timing.targetIqr = t["target_iqr"].numberIn(0.0, 10.0);
+        if (t.has("max_frames")) {
+            c.timing.maxFrames = t["max_frames"].integerIn(1, 100000);
+            if (c.timing.maxFrames < c.timing.timedFrames)
+                t["max_frames"].fail("must be at least \"frames\" (" +
+                                     std::to_string(c.timing.timedFrames) + ")");
+        }
     }
     if (root.has("metrics")) c.metrics = parseMetrics(root["metrics"]);
     if (root.has("shared")) c.shared = parseAssignments(root["shared"], defaultSharedParams());
@@ -403,9 +414,34 @@ size_t countRuns(const ExperimentConfig& config, size_t saturateAt) {
     return total;
 }
 
+size_t planningMemoryBudget() {
+    const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGESIZE);
+    if (pages <= 0 || pageSize <= 0) return size_t(4) << 30;  // unknown: assume 16 GiB
+    return size_t(pages) * size_t(pageSize) / 4;
+}
+
 void checkRunCount(const ExperimentConfig& config) {
     const size_t limit = config.maxRuns;
     const size_t count = countRuns(config, std::numeric_limits<size_t>::max());
+    // Planning holds every run in memory (about 7 KiB a run measured by issue 31's reviewer;
+    // more once the runner keys and records them): refuse what would not fit, with a message,
+    // instead of dying later with std::bad_alloc.
+    const size_t budget = planningMemoryBudget();
+    if (count <= limit && count > budget / kPlanningBytesPerRun) {
+        const auto gib = [](double bytes) {
+            char text[32];
+            std::snprintf(text, sizeof text, "%.1f GiB", bytes / double(size_t(1) << 30));
+            return std::string(text);
+        };
+        throw Error(config.path + ": the sweeps expand to " + std::to_string(count) +
+                    " runs, whose plan needs about " +
+                    gib(double(count) * double(kPlanningBytesPerRun)) + " (" +
+                    std::to_string(kPlanningBytesPerRun / 1024) +
+                    " KiB a run), more than a quarter of this machine's memory (" +
+                    gib(double(budget) * 4.0) + "); at most " +
+                    std::to_string(budget / kPlanningBytesPerRun) +
+                    " runs fit: shrink the sweeps or split the config into several");
+    }
     if (count <= limit) return;
     const std::string countText = count == std::numeric_limits<size_t>::max()
                                       ? "more than " + std::to_string(count)

@@ -5,6 +5,7 @@
  * file is read — unknown keys, unknown techniques, out-of-range parameters and malformed sweeps
  * are errors naming the file and the key path — before any run starts.
  */
+#include <algorithm>
 #include <map>
 #include <optional>
 #include <string>
@@ -38,6 +39,11 @@ struct ReferenceRequest {
 struct TimingPolicy {
     int warmupFrames = 2;
     int timedFrames = 5;
+    // More frames while the frame GPU time's interquartile range is above targetIqr x its median
+    // (lavapipe is noisy), up to maxFrames in all; a run that stops above it is flagged noisy.
+    double targetIqr = 0.10;
+    int maxFrames = 0;  // 0: 4 x timedFrames (at least 20)
+    int frameLimit() const { return maxFrames > 0 ? maxFrames : std::max(4 * timedFrames, 20); }
 };
 
 /** A named region for metrics: a rectangle (normalised 0..1) or an indirect-light mask. */
@@ -70,6 +76,11 @@ struct TechniqueEntry {
 inline constexpr size_t kDefaultMaxRuns = 100000;
 /** The largest "max_runs" a config may set (planning costs memory per run). */
 inline constexpr int kMaxRunsCeiling = 100000000;
+/** What one planned run is taken to cost in memory (checkRunCount refuses a plan that would
+ *  need more than a quarter of the machine's memory). */
+inline constexpr size_t kPlanningBytesPerRun = 16 * 1024;
+/** A quarter of the machine's physical memory: what planning may use. */
+size_t planningMemoryBudget();
 
 struct ExperimentConfig {
     std::string name;
@@ -105,7 +116,8 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config);
 
 /** The number of runs expandRuns would make, without expanding (capped at `saturateAt`). */
 size_t countRuns(const ExperimentConfig& config, size_t saturateAt);
-/** Throws gilab::Error naming the count and "max_runs" if the sweeps exceed config.maxRuns. */
+/** Throws gilab::Error naming the count and "max_runs" if the sweeps exceed config.maxRuns,
+ *  or the memory their plan needs if it exceeds planningMemoryBudget(). */
 void checkRunCount(const ExperimentConfig& config);
 
 /** The metric options as JSON (part of every run's identity). */

@@ -52,7 +52,10 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
     // Against all the light, whatever the technique claims: how far from full GI it is.
     options.referenceStdError = &reference.fullStdError;
     options.resampleFlip = false;
-    out["final_vs_full"] = metrics::toJson(metrics::computeMetrics(final, reference.full, options));
+    metrics::MetricMaps fullMaps;  // the report's headline basis (issue 31): its map first
+    out["final_vs_full"] =
+        metrics::toJson(metrics::computeMetrics(final, reference.full, options, &fullMaps));
+    metrics::writeMagmaPng((outDir / "flip_full.png").string(), fullMaps.flip);
 
     if (bounces != 0 && !reference.indirect.empty()) {
         options.referenceStdError = &reference.indirectStdError;

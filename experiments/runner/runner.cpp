@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <functional>
@@ -410,6 +411,10 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
             frames.push_back(harness->renderFrame());
             progress.update(size_t(i + 1));
         }
+        // Noisy frame times: more frames until the IQR is within target (docs/timing.md).
+        while (int(frames.size()) < c.config.timing.frameLimit() &&
+               cli::frameGpuIqrOverMedian(frames) > c.config.timing.targetIqr)
+            frames.push_back(harness->renderFrame());
     } catch (const DeviceLimitError& e) {  // valid parameters this device cannot run
         progress.finish();
         result["reason"] = std::string("device limit: ") + e.what();
@@ -425,6 +430,14 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(layers, &nonFinite);
     result["timing"] = cli::timingJson(setup, frames, warmup);
+    {
+        const double spread = cli::frameGpuIqrOverMedian(frames);
+        nlohmann::ordered_json& t = result["timing"];
+        t["frames_requested"] = c.config.timing.timedFrames;
+        t["target_iqr"] = c.config.timing.targetIqr;
+        t["iqr_over_median"] = std::isfinite(spread) ? nlohmann::ordered_json(spread) : nullptr;
+        t["noisy"] = std::isfinite(spread) && spread > c.config.timing.targetIqr;
+    }
     std::optional<SequenceResult> sequence;
     if (scene.animation.animated()) {
         // Frames 1..N-1 in order after the static frames at frame 0 (docs/experiments.md).
@@ -471,7 +484,8 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     result["outputs"] = {{"exr", "output.exr"},
                          {"final_png", "final.png"},
                          {"indirect_png", "indirect.png"},
-                         {"flip_png", "flip.png"}};
+                         {"flip_png", "flip.png"},
+                         {"flip_full_png", "flip_full.png"}};
     if (sequence) {
         result["metrics"]["sequence"] = sequence->metrics;
         result["outputs"]["frames_png"] = sequence->framePngs;

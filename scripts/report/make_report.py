@@ -4,8 +4,10 @@
     /usr/bin/python3 scripts/report/make_report.py DIR [DIR ...] [--out OUTDIR]
 
 Reads DIR/runs/<key>/result.json (run folders starting with '.' are in progress and ignored),
-writes OUTDIR/report.html (self-contained: inline CSS/JS, images by relative path) and
-OUTDIR/figures/*.svg, and prints the path of report.html. OUTDIR defaults to the first DIR.
+writes OUTDIR/report.html (self-contained: inline CSS/JS and the inspector's linear values,
+images by relative path), OUTDIR/figures/*.svg and OUTDIR/maps/*.png (the report's own error
+maps against the full reference), and prints the path of report.html. OUTDIR defaults to the
+first DIR.
 Runs found in several DIRs (the same key) are kept once. Every section and number is described
 in docs/report.md.
 """
@@ -24,11 +26,12 @@ import report_figures  # noqa: E402
 from report_analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,  # noqa: E402
                              best_runs, by_device, by_scene, find_sweeps, has_one_bounce,
                              pareto_fronts, pareto_ties, pass_colors, scene_basis, slug,
-                             technique_colors)
+                             sweep_names, technique_colors)
 from report_noop import no_effect  # noqa: E402
 from report_data import Results, Run, load_results  # noqa: E402
 from report_common import Figures, Page  # noqa: E402
 from report_html import render_page  # noqa: E402
+from report_inspect import Inspector, clear_old_maps  # noqa: E402
 
 REPO_DOCS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
                                           "docs"))
@@ -104,13 +107,13 @@ def write_figures(results: Results, colors: dict[str, str], fig_dir: str) -> Fig
             path = os.path.join(fig_dir, f"temporal_{slug(scene)}.svg")
             report_figures.temporal_figure(animated, colors, path, scene)
             figures.temporal[scene] = path
-    for sweep in find_sweeps(runs):
+    sweeps = find_sweeps(runs)
+    for sweep, stem in zip(sweeps, sweep_names(sweeps)):
         why = no_effect(sweep)
         if why:
             figures.no_effect.append((sweep, why))
             continue
-        name = f"sweep_{slug(sweep.technique)}_{slug(sweep.scene)}_{slug(sweep.key)}.svg"
-        path = os.path.join(fig_dir, name)
+        path = os.path.join(fig_dir, f"{stem}.svg")
         basis = scene_basis(scenes[sweep.scene])
         baseline = None
         if sweep.technique != BASELINE_TECHNIQUE:
@@ -145,6 +148,7 @@ def build_report(dirs: list[str], out_dir: str) -> str:
     os.makedirs(out_dir, exist_ok=True)
     colors = technique_colors([r.technique for r in results.runs])
     figures = write_figures(results, colors, os.path.join(out_dir, "figures"))
+    clear_old_maps(out_dir)
     scenes = by_scene(results.runs)
     bases = {scene: scene_basis(rs) for scene, rs in scenes.items()}
     fronts = {s: page_fronts(rs, bases[s]) for s, rs in scenes.items()}
@@ -154,7 +158,7 @@ def build_report(dirs: list[str], out_dir: str) -> str:
                 docs_dir=REPO_DOCS if os.path.isdir(REPO_DOCS) else None,
                 generated=datetime.datetime.now(datetime.timezone.utc)
                 .strftime("%Y-%m-%dT%H:%M:%SZ"),
-                tool_versions=tool_versions())
+                tool_versions=tool_versions(), inspector=Inspector(out_dir))
     path = os.path.join(out_dir, "report.html")
     tmp = path + f".tmp-{os.getpid()}"
     with open(tmp, "w", encoding="utf-8") as f:

@@ -364,7 +364,10 @@ def cheapest_reaching(runs: list[Run], target: float, basis: Basis) -> Optional[
 
 @dataclass
 class Sweep:
-    """Runs of one technique on one scene that vary `key`; one series per value of the others."""
+    """Runs of one technique on one scene that vary `key`; one series per value of the others.
+    The runs of one sweep share one set of swept keys (technique.swept): two sweeps of a
+    technique over different keys (e.g. `direct` over shared.pcf_radius and, apart, over
+    shared.area_light_samples) are never drawn as one grid."""
 
     technique: str
     scene: str
@@ -372,6 +375,7 @@ class Sweep:
     other_keys: list[str]
     series: dict[tuple, list[Run]]  # values of other_keys -> runs sorted by the swept value
     numeric: bool  # every value of `key` is a number
+    keys: tuple[str, ...] = ()  # the sweep's swept keys (key and other_keys), sorted
 
 
 def param_value(run: Run, key: str) -> object:
@@ -392,13 +396,16 @@ def sweep_x(run: Run, key: str) -> Optional[float]:
 
 
 def find_sweeps(runs: list[Run]) -> list[Sweep]:
-    """Every (technique, scene, swept key) whose measured runs take ≥ 2 values of that key."""
+    """Every (technique, scene, set of swept keys, swept key) whose measured runs take ≥ 2
+    values of that key. Runs belong to one sweep only when they share the same set of swept
+    keys (technique.swept)."""
     sweeps: list[Sweep] = []
-    groups: dict[tuple[str, str], list[Run]] = {}
+    groups: dict[tuple[str, str, tuple[str, ...]], list[Run]] = {}
     for run in runs:
         if run.measured and run.swept:
-            groups.setdefault((run.technique, run.scene), []).append(run)
-    for (tech, scene), group in sorted(groups.items()):
+            keyset = tuple(sorted(run.swept))
+            groups.setdefault((run.technique, run.scene, keyset), []).append(run)
+    for (tech, scene, keyset), group in sorted(groups.items()):
         keys = ordered_unique([k for r in group for k in r.swept])
         for key in keys:
             values = {text(param_value(r, key)) for r in group}
@@ -413,8 +420,16 @@ def find_sweeps(runs: list[Run]) -> list[Sweep]:
                 members.sort(key=lambda r: (sweep_x(r, key) if numeric else 0.0,
                                             text(param_value(r, key))))
             ordered = dict(sorted(series.items(), key=lambda item: _series_order(item[0])))
-            sweeps.append(Sweep(tech, scene, key, others, ordered, numeric))
+            sweeps.append(Sweep(tech, scene, key, others, ordered, numeric, keyset))
     return sweeps
+
+
+def sweep_names(sweeps: list[Sweep]) -> list[str]:
+    """A file-name stem per sweep: 'sweep_<technique>_<scene>_<key>', with '_in_<keys>' added
+    where one technique sweeps the same key in two sweeps of a scene."""
+    plain = [f"sweep_{slug(s.technique)}_{slug(s.scene)}_{slug(s.key)}" for s in sweeps]
+    return [name if plain.count(name) == 1 else f"{name}_in_{slug('+'.join(s.keys))}"
+            for name, s in zip(plain, sweeps)]
 
 
 def _series_order(values: tuple) -> tuple:

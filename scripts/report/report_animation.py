@@ -11,9 +11,10 @@ from typing import Optional
 
 from report_analysis import by_scene, by_technique, best_key, ordered_unique, slug
 from report_common import (DASH, Page, doc_link, esc, fmt_fixed, fmt_flip, fmt_ms, img_html,
-                           params_html, rel_url, swatch, update_badge, with_bar)
+                           noisy_mark, params_html, rel_url, swatch, time_with_bar,
+                           update_badge)
 from report_data import Run, Temporal, TimeSummary
-from report_device import DYNAMIC_FRAME, device_label, time_label
+from report_device import DYNAMIC_FRAME, device_label, device_names, time_label
 
 STRIP_IMAGE_WIDTH = 72  # CSS px of each thumbnail of the frame strip
 
@@ -43,7 +44,7 @@ def _ordered(runs: list[Run], page: Page) -> list[Run]:
 def _time_cell(summary: Optional[TimeSummary], col: str) -> str:
     median = summary.median if summary is not None else None
     iqr = summary.iqr if summary is not None else None
-    shown = with_bar(fmt_ms(median), iqr, fmt_ms)
+    shown = time_with_bar(median, iqr)
     if summary is not None and summary.source == "cpu" and col != "update":
         shown += ' <span class="pm">(CPU clock)</span>'
     value = "" if median is None else repr(median)
@@ -72,16 +73,20 @@ def cost_table(runs: list[Run], page: Page) -> str:
                  _time_cell(anim.dynamic if anim else None, "dynamic"),
                  _time_cell(anim.update_cpu if anim else None, "update")]
         own = dict(anim.update_passes) if anim else {}
+        spread = anim.update_pass_times if anim else {}
         for name in passes:
             value = own.get(name)
+            iqr = spread[name].iqr if name in spread else None
             cells.append(f'<td class="n" data-col="pass" data-v="'
-                         f'{"" if value is None else repr(value)}">{fmt_ms(value)}</td>')
+                         f'{"" if value is None else repr(value)}">{fmt_ms(value)}'
+                         f'{noisy_mark(value, iqr, True)}</td>')
         rows.append(f'<tr data-key="{esc(run.key)}">{_run_cells(run, page)}{"".join(cells)}'
                     "</tr>")
     head = "".join(f"<th>{esc(h)}</th>" for h in heads)
     return (f'<div class="table-wrap"><table class="data cost" data-device="'
-            f'{esc(device_label(runs))}"><thead><tr>{head}</tr></thead><tbody>{"".join(rows)}'
-            "</tbody></table></div>")
+            f'{esc(device_label(runs))}"><caption class="device-line">timed on '
+            f'{esc(device_names(runs))}</caption><thead><tr>{head}</tr></thead><tbody>'
+            f'{"".join(rows)}</tbody></table></div>')
 
 
 def _temporal_cell(block: Temporal, col: str) -> str:

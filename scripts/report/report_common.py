@@ -10,10 +10,12 @@ from typing import Callable, Optional
 
 from report_analysis import MATCHED, Basis, Sweep, ordered_unique, param_value, slug
 from report_data import Results, Run, dig, num, text
+from report_inspect import Inspector
+from report_noise import NOISY_IQR_FRACTION, noisy_time
 
 DASH = "—"
-CARD_IMAGE_WIDTH = 150  # CSS px of each image in the scene cards (four side by side)
-REF_IMAGE_WIDTH = 150
+CARD_IMAGE_WIDTH = 128  # CSS px of each image in the scene cards (five side by side)
+REF_IMAGE_WIDTH = 128
 MIB = 1024.0 * 1024.0
 
 
@@ -43,6 +45,7 @@ class Page:
     docs_dir: Optional[str]
     generated: str
     tool_versions: str
+    inspector: Optional[Inspector] = None  # the image inspector's data (report_inspect)
 
     def basis(self, scene: str) -> Basis:
         return self.bases.get(scene) or MATCHED
@@ -87,9 +90,10 @@ def png_size(path: str) -> Optional[tuple[int, int]]:
 
 
 def img_html(path: Optional[str], page: Page, alt: str, width: int, css: str = "",
-             lazy: bool = False) -> str:
+             lazy: bool = False, inspect: Optional[tuple[str, int]] = None) -> str:
     """An <img> of a PNG shown `width` CSS px wide (linked to the full-size file), or a
-    placeholder naming the missing file."""
+    placeholder naming the missing file. inspect: (group id, layer index) of the image in the
+    inspector, which a click opens (report_inspect)."""
     if not path or not os.path.isfile(path):
         where = os.path.relpath(path, page.out_dir) if path else "no file recorded"
         return f'<div class="missing">{esc(alt)}: image missing<br>{esc(where)}</div>'
@@ -100,8 +104,13 @@ def img_html(path: Optional[str], page: Page, alt: str, width: int, css: str = "
         classes.append("px")
     url = rel_url(path, page.out_dir)
     loading = ' loading="lazy"' if lazy else ""
-    return (f'<a href="{url}"><img src="{url}" alt="{esc(alt)}" title="{esc(alt)}" '
-            f'width="{width}" height="{height}" class="{" ".join(classes)}"{loading} '
+    data = ""
+    if inspect is not None:
+        classes.append("inspectable")
+        data = f' data-ig="{esc(inspect[0])}" data-il="{inspect[1]}"'
+    tip = alt + (" (click to inspect)" if inspect is not None else "")
+    return (f'<a href="{url}"><img src="{url}" alt="{esc(alt)}" title="{esc(tip)}" '
+            f'width="{width}" height="{height}" class="{" ".join(classes)}"{loading}{data} '
             f'onerror="gilabImageError(this)"></a>')
 
 
@@ -133,6 +142,29 @@ def with_bar(value: str, sigma: Optional[float], fmt: Callable[[Optional[float]]
     if sigma is None or value == DASH:
         return value
     return f'{value} <span class="pm">± {fmt(sigma)}</span>'
+
+
+NOISY_TIP = (f"noisy timing: its interquartile range is more than "
+             f"{100 * NOISY_IQR_FRACTION:.0f} % of its median, so differences smaller than the "
+             "IQR are not resolved; time more frames (docs/timing.md)")
+
+
+def noisy_mark(median: Optional[float], iqr: Optional[float], compact: bool = False) -> str:
+    """A visible marker after a timing whose IQR is above NOISY_IQR_FRACTION of its median
+    ('' otherwise): '⚠ noisy (IQR 35 %)', compact (table cells) '⚠ 35 %'; its tooltip and the
+    page's note explain it."""
+    if not noisy_time(median, iqr):
+        return ""
+    share = 100.0 * iqr / median
+    words = f"⚠ {share:.0f} %" if compact else f"⚠ noisy (IQR {share:.0f} %)"
+    return (f' <span class="noisy" data-noisy="{share:.1f}" title="{esc(NOISY_TIP)}">'
+            f"{words}</span>")
+
+
+def time_with_bar(median: Optional[float], iqr: Optional[float], compact: bool = True) -> str:
+    """'12.3 ± 0.4' with the noisy marker where the IQR is above 10 % of the median (compact,
+    for table cells)."""
+    return with_bar(fmt_ms(median), iqr, fmt_ms) + noisy_mark(median, iqr, compact)
 
 
 def swatch(tech: str, page: Page) -> str:

@@ -209,6 +209,7 @@ class Animation:
     dynamic: TimeSummary = field(default_factory=TimeSummary)  # dynamic_frame_{gpu,cpu}_ms
     update_cpu: TimeSummary = field(default_factory=TimeSummary)  # update_cpu_ms
     update_passes: list[tuple[str, Optional[float]]] = field(default_factory=list)
+    update_pass_times: dict[str, TimeSummary] = field(default_factory=dict)  # name -> summary
 
     @property
     def measured_count(self) -> Optional[int]:
@@ -263,6 +264,9 @@ def parse_animation(data: dict) -> Optional["Animation"]:
     passes = dig(data, "timing", "update_passes")
     update_passes = [(text(p.get("name")) or "?", num(dig(p, "gpu_ms", "median")))
                      for p in (passes if isinstance(passes, list) else []) if isinstance(p, dict)]
+    update_pass_times = {text(p.get("name")) or "?": TimeSummary.parse(p.get("gpu_ms"), "gpu")
+                         for p in (passes if isinstance(passes, list) else [])
+                         if isinstance(p, dict)}
     update = block.get("update")
     return Animation(
         frames=int(count) if count is not None else None,
@@ -282,7 +286,8 @@ def parse_animation(data: dict) -> Optional["Animation"]:
         temporal_matched=Temporal.parse(sequence.get("temporal_matched")),
         dynamic=dynamic,
         update_cpu=TimeSummary.parse(dig(data, "timing", "update_cpu_ms"), "cpu"),
-        update_passes=update_passes)
+        update_passes=update_passes,
+        update_pass_times=update_pass_times)
 
 
 def _sequence_mean(sequence: dict, key: str, per_frame: list[Optional[float]]
@@ -375,11 +380,16 @@ class Run:
 
     def passes(self) -> list[tuple[str, Optional[float]]]:
         """Per-frame passes in recorded order: (name, median GPU ms)."""
+        return [(name, summary.median) for name, summary in self.pass_times()]
+
+    def pass_times(self) -> list[tuple[str, "TimeSummary"]]:
+        """Per-frame passes in recorded order: (name, GPU time summary: median, IQR)."""
         out = []
         passes = dig(self.data, "timing", "passes")
         for entry in passes if isinstance(passes, list) else []:
             if isinstance(entry, dict):
-                out.append((text(entry.get("name")) or "?", num(dig(entry, "gpu_ms", "median"))))
+                out.append((text(entry.get("name")) or "?",
+                            TimeSummary.parse(entry.get("gpu_ms"), "gpu")))
         return out
 
     def setup_stages(self) -> list[tuple[str, Optional[float]]]:

@@ -113,3 +113,11 @@ def device_note_html(runs: list[Run]) -> str:
             "CPU cores, so techniques rank differently than they would on a GPU (memory "
             "bandwidth, occupancy and fixed-function hardware are not modelled). Compare times "
             + ("only within this report." if not mixed else "only between runs on one device."))
+
+
+def device_names(runs: list[Run]) -> str:
+    """The device model(s) the runs' times were measured on, named by device.name with their
+    kind: 'llvmpipe (LLVM 15.0.6, 256 bits) (lavapipe, CPU)'; several joined by ' and ' (for
+    the captions of every table and figure that compares techniques)."""
+    timed = [r for r in runs if r.frame_ms is not None] or runs
+    return " and ".join(device_groups(timed)) or UNKNOWN_DEVICE

@@ -23,6 +23,7 @@ from report_analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # no
 from report_device import (DYNAMIC_FRAME, device_group, device_groups,  # noqa: E402
                            device_label, dynamic_clock, nodes_phrase, time_label)
 from report_data import Run, Temporal, text  # noqa: E402
+from report_noise import NOISY_IQR_FRACTION, noisy_run, noisy_time  # noqa: E402
 
 STYLE = {
     "svg.fonttype": "none",
@@ -45,6 +46,9 @@ FRONT_STYLES = ("--", ":", "-.", (0, (6, 2, 1, 2, 1, 2)), (0, (1, 1)), (0, (8, 3
 IQR_GID = "iqr-bars"  # SVG id prefix of the frame-time IQR bars (the report's test looks for it)
 SEQUENCE_GID = "seq-line-"  # + run key: one line per run in the per-frame error figure
 TEMPORAL_GID = "temporal-bar-"  # + run key: one bar per run in the temporal-instability figure
+NOISY_GID = "noisy-time-"  # + run key: the marker of a noisy frame time (IQR > 10 % of median)
+NOISY_COLOR = "#b3261e"
+NOISY_LABEL = f"noisy frame time: IQR > {100 * NOISY_IQR_FRACTION:.0f} % of the median"
 LOG_SPAN = 10.0  # use a log axis when the largest positive value is > LOG_SPAN x the smallest
 
 Metric = Callable[[Run], Optional[float]]
@@ -94,6 +98,21 @@ def axis_time_label(runs: list[Run], what: str) -> str:
     unit stay together on the last line)."""
     return time_label(runs, what).replace(f", {DYNAMIC_FRAME}", ", dynamic frame\n"
                                           + DYNAMIC_FRAME[len("dynamic frame "):])
+
+
+def _noisy_marks(ax: plt.Axes, points: list[tuple[Run, float, float]]) -> None:
+    """A red square around every point whose frame time is noisy (IQR above
+    NOISY_IQR_FRACTION of the median), each with its SVG id (NOISY_GID + key)."""
+    for run, x, y in points:
+        if noisy_run(run):
+            mark, = ax.plot([x], [y], "s", ms=13, mfc="none", mec=NOISY_COLOR, mew=1.1,
+                            ls="none", zorder=5)
+            mark.set_gid(f"{NOISY_GID}{run.key}")
+
+
+def _noisy_handle() -> Line2D:
+    return Line2D([], [], marker="s", ls="none", ms=11, mfc="none", mec=NOISY_COLOR,
+                  label=NOISY_LABEL)
 
 
 def _static_marks(ax: plt.Axes, runs: list[Run], colors: dict[str, str], error: Metric
@@ -154,6 +173,7 @@ def _scatter_panel(ax: plt.Axes, runs: list[Run], colors: dict[str, str], basis:
         ys = [error(r) for r in front] + [error(front[-1])]
         ax.step(xs, ys, where="post", color="black", lw=1.0, ls=style, zorder=2)
         ax.plot(xs[:-1], ys[:-1], "o", ms=9, mfc="none", mec="black", mew=0.8, zorder=4)
+    _noisy_marks(ax, [(r, r.frame_ms, error(r)) for r in plotted])
     tied = [r for ties in pareto_ties(runs, basis, error, sigma).values()
             for r in plotted if id(r) in ties]
     if tied:
@@ -189,6 +209,8 @@ def _pareto_legend(fig: plt.Figure, runs: list[Run], colors: dict[str, str],
     if dynamic_clock([r for r in runs if r.measured]):
         handles.append(Line2D([], [], marker="o", ls=":", color="#777777", mfc="white",
                               label="static frame of the same run (nothing moved, no update)"))
+    if any(noisy_run(r) for r in runs if r.measured and r.frame_ms is not None):
+        handles.append(_noisy_handle())
     fig.legend(handles=handles, loc="upper center", ncol=min(len(handles), 4),
                bbox_to_anchor=(0.5, 0.0), frameon=False)
 
@@ -302,6 +324,8 @@ def _sweep_panel(ax: plt.Axes, sweep: Sweep, color: str, panel: "SweepPanel",
                                  elinewidth=0.9, capsize=3, label=label)
         if panel.is_time and bars is not None:
             drawn_bars.lines[2][0].set_gid(IQR_GID)
+        if panel.is_time:
+            _noisy_marks(ax, list(zip(ok, xs, ys)))
         bad = [r for r in members if r.status == "nonfinite" and panel.value(r) is not None]
         if bad:
             drawn += [panel.value(r) for r in bad]
@@ -414,6 +438,8 @@ def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str, basis: Basis,
     if any(r.status == "nonfinite" for m in sweep.series.values() for r in m):
         extra = [Line2D([], [], marker="X", ls="none", color="#999999", mec="black",
                         label="nonfinite output")]
+    if any(r.status == "ok" and noisy_run(r) for m in sweep.series.values() for r in m):
+        extra.append(_noisy_handle())
     if len(handles) > 1 or extra or baseline is not None:
         fig.legend(handles=handles + extra, loc="upper center",
                    ncol=min(len(handles) + len(extra), 4), bbox_to_anchor=(0.5, 0.0),
@@ -424,16 +450,25 @@ def sweep_figure(sweep: Sweep, colors: dict[str, str], path: str, basis: Basis,
 
 
 def _stacked_bars(ax: plt.Axes, best: list[Run], stacks: list[list[tuple[str, float]]],
-                  color: Callable[[Run, str], str]) -> None:
-    """One stacked bar per run, its total written above it."""
+                  color: Callable[[Run, str], str],
+                  noisy: Optional[Callable[[Run, str], bool]] = None,
+                  starred: Optional[Callable[[Run], bool]] = None) -> None:
+    """One stacked bar per run, its total written above it; a segment for which noisy() holds
+    is hatched, a total for which starred() holds gets a '*'."""
     for i, (run, stack) in enumerate(zip(best, stacks)):
         bottom = 0.0
         for name, value in stack:
-            ax.bar(i, value, bottom=bottom, width=0.6, color=color(run, name),
-                   edgecolor="white", linewidth=0.5)
+            hatched = noisy is not None and noisy(run, name)
+            bars = ax.bar(i, value, bottom=bottom, width=0.6, color=color(run, name),
+                          edgecolor=NOISY_COLOR if hatched else "white", linewidth=0.5,
+                          hatch="////" if hatched else None)
+            if hatched:
+                bars.patches[0].set_gid(f"{NOISY_GID}pass-{run.key}-{name}")
             bottom += value
         if stack:
-            ax.text(i, bottom, f"{bottom:.3g}", ha="center", va="bottom", fontsize=8)
+            star = "*" if starred is not None and starred(run) else ""
+            ax.text(i, bottom, f"{bottom:.3g}{star}", ha="center", va="bottom", fontsize=8,
+                    color=NOISY_COLOR if star else "black")
     labels = [r.technique for r in best]
     rotate = len(labels) > 3
     ax.set_xticks(range(len(labels)), labels, rotation=20 if rotate else 0,
@@ -463,7 +498,17 @@ def passes_figure(best: list[Run], tech_colors: dict[str, str], pass_colors: dic
             else stage_colors[name]
 
     fig, axes = plt.subplots(1, 2, figsize=(10.0, 3.9), gridspec_kw={"wspace": 0.75})
-    _stacked_bars(axes[0], best, frame, lambda run, name: pass_colors[name])
+    spread = {id(r): dict(r.pass_times()) for r in best}
+
+    def noisy_pass(run: Run, name: str) -> bool:
+        summary = spread[id(run)].get(name)
+        return summary is not None and noisy_time(summary.median, summary.iqr)
+
+    def noisy_frame(run: Run) -> bool:
+        return noisy_time(run.static.median, run.static.iqr)
+
+    _stacked_bars(axes[0], best, frame, lambda run, name: pass_colors[name], noisy_pass,
+                  noisy_frame)
     static = "static " if any(r.animated for r in best) else ""
     axes[0].set_ylabel(time_label(best, f"median time per {static}frame"))
     axes[0].set_title(f"per-{static}frame time by pass ({device_label(best)})")
@@ -478,6 +523,11 @@ def passes_figure(best: list[Run], tech_colors: dict[str, str], pass_colors: dic
     for ax in axes:
         for tick, run in zip(ax.get_xticklabels(), best):
             tick.set_color(tech_colors.get(run.technique, "black"))
+    if any(noisy_pass(r, n) for r, stack in zip(best, frame) for n, _ in stack) or \
+            any(noisy_frame(r) for r in best):
+        fig.text(0.5, -0.02, "noisy timings: hatched (red edge), a pass whose IQR is above "
+                 f"{100 * NOISY_IQR_FRACTION:.0f} % of its median; a total with *, a frame whose "
+                 "IQR is", ha="center", va="top", fontsize=8, color=NOISY_COLOR)
     fig.suptitle(f"{scene}: where the time goes (best run per technique)", fontsize=10, y=1.0)
     _save(fig, path)
 

@@ -2,27 +2,33 @@
 
 Each section is one function returning an HTML string; a section that applies to no run
 returns "" and is left out of the page and its navigation. The tables are in report_tables.py,
-the shared helpers in report_common.py.
+the shared helpers in report_common.py, the image inspector's data in report_inspect.py.
 """
 from __future__ import annotations
 
 import os
+from dataclasses import dataclass
 from typing import Optional
 
-from report_analysis import (Sweep, best_runs, by_device, by_scene, param_value,
-                             params_text, pareto_fronts, pareto_ties)
-from report_assets import BODY_JS, CSS, HEAD_JS, MAGMA_STOPS
+from report_analysis import (Sweep, best_key, best_runs, by_device, by_scene, param_value,
+                             params_text, pareto_fronts, pareto_ties, slug)
+from report_assets import BODY_JS, CSS, HEAD_JS, INSPECTOR_JS, MAGMA_STOPS
 from report_animation import animation_anchor, animation_html
-from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link, esc,
-                           fmt_fixed, fmt_flip, fmt_ms, fmt_sig, img_html, nonfinite_count, params_html,
-                           rel_url, scene_anchor, status_badge, swatch, update_badge, with_bar)
+from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link,
+                           esc, fmt_fixed, fmt_flip, fmt_ms, fmt_sig, img_html, noisy_mark,
+                           nonfinite_count, params_html, rel_url, scene_anchor, status_badge,
+                           swatch, time_with_bar, update_badge, with_bar)
 from report_data import Run, dig, num, text
-from report_device import (DYNAMIC_FRAME, device_groups, device_label, dynamic_clock,
-                           hosts_of, nodes_phrase, time_label)
-from report_noise import change_words, tied_best, time_change_words
+from report_device import (DYNAMIC_FRAME, device_groups, device_label, device_names,
+                           dynamic_clock, hosts_of, nodes_phrase, time_label)
+from report_inspect import BUDGET_CHARS, MAX_PIXELS, Layer
+from report_noise import (NOISY_IQR_FRACTION, change_words, noisy_run, noisy_time, tied_best,
+                          time_change_words)
 from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
                            invalid_banner_html, run_table_html, skipped_html, unreadable_html)
 
+
+NOISY_PERCENT = f"{100 * NOISY_IQR_FRACTION:.0f}"
 
 # ---------------------------------------------------------------------------------------------
 # Section 2: images per scene
@@ -38,7 +44,7 @@ def _metric_line(label: str, view_flip: Optional[float], sigma: Optional[float],
 def _time_line(css: str, median: Optional[float], iqr: Optional[float], label: str) -> str:
     bar = f' <span class="pm">± {fmt_ms(iqr)}</span>' if iqr is not None else ""
     return (f'<div class="{css}">{fmt_ms(median)}{bar} ms <span class="muted">{esc(label)}'
-            "</span></div>")
+            f"</span>{noisy_mark(median, iqr)}</div>")
 
 
 def _card_numbers(run: Run, page: Page, ties: list[Run]) -> str:
@@ -84,49 +90,140 @@ def _exr_link(run: Run, page: Page) -> str:
     return f'<a class="exr" href="{rel_url(path, page.out_dir)}">output.exr (linear)</a>'
 
 
-def _card(run: Run, page: Page, best: bool, lazy: bool, ties: list[Run]) -> str:
+def _exists(path: Optional[str]) -> bool:
+    return bool(path) and os.path.isfile(path)
+
+
+# What the report's own error map is, where the runner wrote no HDR-FLIP map against the full
+# reference (report_inspect.relerr_map).
+RELERR_WORDS = ("per pixel |Y(run) − Y(full reference)| / mean Y(full reference), Y the linear "
+                "luminance, in magma from 0 to 1 (1: an error as large as the reference's mean "
+                "luminance). It is not HDR-FLIP: the runner wrote no FLIP map against the full "
+                "reference (outputs.flip_full_png)")
+
+
+@dataclass
+class _Slot:
+    """One image of a run card / the references card and its layer in the inspector."""
+
+    layer: Layer
+    caption: Optional[str]  # None: only in the inspector, not on the card
+    css: str = ""
+    tip: str = ""
+
+
+def _card_slots(run: Run, page: Page) -> tuple[list[_Slot], str]:
+    """The run's layers in the inspector's flipping order (run, reference of the headline basis,
+    its error map, the bounce-matched error map and reference, the indirect layers), those the
+    card shows with a caption; and a note when no error map against the full reference can be
+    shown."""
+    ins = page.inspector
+    basis = page.basis(run.scene)
+    label = run.reference_label() or "reference"
+    frame0 = " (frame 0)" if run.animated else ""
+    run_exr, full_exr = run.output_path("exr"), run.reference_path("full_exr")
+    matched_exr = run.reference_path("final_exr")
+    lin_run = ins.linear(run_exr) if ins else None
+    slots = [_Slot(Layer("run" + frame0, run.output_path("final_png") or "", lin_run,
+                         why=ins.why_not(run_exr) if ins else ""), "final" + frame0, "expo")]
+    note = ""
+    full_png = run.reference_path("full_png")
+    if basis.name != "matched" and _exists(full_png):
+        lin_full = ins.linear(full_exr) if ins else None
+        slots.append(_Slot(Layer("full reference", full_png, lin_full,
+                                 why=ins.why_not(full_exr) if ins else ""), None))
+        flip_full = run.output_path("flip_full_png")
+        made = None
+        if _exists(flip_full):
+            slots.append(_Slot(Layer("HDR-FLIP vs full reference" + frame0, flip_full,
+                                     kind="map", expo=False),
+                               f"HDR-FLIP map vs full reference{frame0}", "flipmap errfull"))
+        elif ins is not None:
+            made = ins.relerr_map(f"{slug(run.key)}_error_vs_full", lin_run, lin_full)
+            if made:
+                slots.append(_Slot(Layer("error vs full reference" + frame0, made[0],
+                                         kind="relerr", expo=False, a=lin_run, b=lin_full,
+                                         mean=made[1]),
+                                   f"error vs full reference{frame0}: |ΔY| / mean Y, linear "
+                                   "(not HDR-FLIP: no FLIP map vs full on disk)",
+                                   "flipmap errfull relerr",
+                                   RELERR_WORDS))
+        if not _exists(flip_full) and not made:
+            why = (ins.why_not(run_exr) or ins.why_not(full_exr)) if ins else ""
+            note = ('<div class="muted no-full-map">No error map against the full reference: '
+                    "the runner wrote none (<code>outputs.flip_full_png</code>) and the report "
+                    f"could not draw one from the linear images{': ' + esc(why) if why else ''}"
+                    ".</div>")
+    slots.append(_Slot(Layer(f"HDR-FLIP vs bounce-matched reference ({label}){frame0}",
+                             run.output_path("flip_png") or "", kind="map", expo=False),
+                       f"HDR-FLIP map vs bounce-matched reference ({label}){frame0}",
+                       "flipmap errmatched"))
+    matched_png = run.reference_png()
+    if _exists(matched_png):
+        lin_matched = ins.linear(matched_exr) if ins else None
+        slots.append(_Slot(Layer(f"bounce-matched reference ({label})", matched_png,
+                                 lin_matched, why=ins.why_not(matched_exr) if ins else ""),
+                           None))
+    if run.output_path("indirect_png"):  # its values stay in the EXR (page size)
+        slots.append(_Slot(Layer("indirect (this run)", run.output_path("indirect_png"),
+                                 why="not embedded (the run's EXR has them: layer indirect)"),
+                           "indirect (this run)", "expo indirect"))
+        ref_indirect = run.reference_path("indirect_png")
+        if ref_indirect:  # older results lack it (the references card says so)
+            slots.append(_Slot(Layer(f"reference indirect ({label} − emission − direct)",
+                                     ref_indirect, why="8-bit preview only (no EXR of this "
+                                     "layer)"),
+                               f"reference indirect ({run.reference_label() or 'matched'} − "
+                               "emission − direct)", "expo refindirect"))
+    return slots, note
+
+
+def _slot_figures(slots: list[_Slot], page: Page, title: str, width: int, lazy: bool,
+                  alt_prefix: str) -> str:
+    """The captioned slots as <figure>s; every existing image opens the inspector on its
+    layer (group of all the existing slots)."""
+    present = [s for s in slots if _exists(s.layer.path)]
+    group = page.inspector.group(title, [s.layer for s in present]) if page.inspector and \
+        present else None
+    out = []
+    for slot in slots:
+        if slot.caption is None:
+            continue
+        index = next((i for i, s in enumerate(present) if s is slot), None)
+        inspect = (group, index) if group is not None and index is not None else None
+        img = img_html(slot.layer.path or None, page, f"{alt_prefix} {slot.caption}", width,
+                       slot.css, lazy, inspect)
+        tip = f' title="{esc(slot.tip)}"' if slot.tip else ""
+        out.append(f'<figure style="width:{width}px">{img}<figcaption{tip}>'
+                   f"{esc(slot.caption)}</figcaption></figure>")
+    return "".join(out)
+
+
+def _card(run: Run, page: Page, rank: Optional[int], badge: str, lazy: bool,
+          ties: list[Run]) -> str:
+    """A run's card: its rank on the scene's basis (None: not ranked, e.g. the other runs of a
+    technique), the badge of the overall best, images, numbers and the EXR link."""
     color = page.colors.get(run.technique, "#888")
-    badges = ""
-    if best:
-        badges = ('<span class="badge b-best">best</span>' if not ties else
-                  '<span class="badge b-tie" title="another run is within the error bars">'
-                  'best (tie)</span>')
+    badges = f'<span class="rank" title="rank on the scene\'s ranking basis">#{rank}</span>' \
+        if rank is not None else ""
+    badges += badge
     if run.status != "ok":
         badges += status_badge(run.status)
     if run.final.within_reference_noise:
         badges += '<span class="badge b-noise">within ref. noise</span>'
     badges += update_badge(run)
-    width = CARD_IMAGE_WIDTH
-    frame0 = " (frame 0)" if run.animated else ""
-    figures = [(img_html(run.output_path("final_png"), page, f"{run.technique} final", width,
-                         "expo", lazy), "final" + frame0)]
-    figures.append((img_html(run.output_path("flip_png"), page, f"{run.technique} FLIP map",
-                             width, "flipmap", lazy),
-                    f"HDR-FLIP map vs {run.reference_label() or 'reference'}{frame0}"))
-    if run.output_path("indirect_png"):
-        figures.append((img_html(run.output_path("indirect_png"), page,
-                                 f"{run.technique} indirect", width, "expo indirect", lazy),
-                        "indirect (this run)"))
-        ref_indirect = run.reference_path("indirect_png")
-        if ref_indirect:  # older results lack it (the references card says so)
-            figures.append((img_html(ref_indirect, page, "reference indirect", width,
-                                     "expo refindirect", lazy),
-                            f"reference indirect ({run.reference_label() or 'matched'} − "
-                            "emission − direct)"))
-    pair = "".join(f'<figure style="width:{width}px">{img}<figcaption>{esc(cap)}</figcaption>'
-                   "</figure>" for img, cap in figures)
-    return (f'<div class="card" style="border-top-color:{color}" data-key="{esc(run.key)}">'
+    slots, note = _card_slots(run, page)
+    title = f"{run.technique} on {run.scene}" + (f" ({params_text(run, True)})"
+                                                 if run.swept else "")
+    pair = _slot_figures(slots, page, title, CARD_IMAGE_WIDTH, lazy, run.technique)
+    rank_attr = "" if rank is None else f' data-rank="{rank}"'
+    return (f'<div class="card" style="border-top-color:{color}" data-key="{esc(run.key)}"'
+            f'{rank_attr}>'
             f'<div class="card-title">{swatch(run.technique, page)}{badges}</div>'
             f'<div class="card-params">{params_html(run)}</div>'
-            f'<div class="pair">{pair}</div>'
+            f'<div class="pair">{pair}</div>{note}'
             f'<div class="card-nums">{_card_numbers(run, page, ties)}</div>'
             f'<div class="card-links">{_exr_link(run, page)}</div></div>')
-
-
-def _reference_figure(path: str, page: Page, label: str, detail: list[str], css: str) -> str:
-    image = img_html(path, page, f"reference {label}", REF_IMAGE_WIDTH, "expo " + css)
-    return (f'<figure style="width:{REF_IMAGE_WIDTH}px">{image}<figcaption><b>{esc(label)}</b>'
-            f'{"<br>" + esc(", ".join(detail)) if detail else ""}</figcaption></figure>')
 
 
 def _references_html(runs: list[Run], page: Page) -> str:
@@ -141,10 +238,13 @@ def _references_html(runs: list[Run], page: Page) -> str:
             path = run.reference_path(name)
             if path and path not in seen:
                 seen[path] = run
-    cards = []
-    for path in full:
-        cards.append(_reference_figure(path, page, "full reference (all light paths)",
-                                       [], "ref-full"))
+    ins = page.inspector
+    slots = []
+    for path, run in full.items():
+        exr = run.reference_path("full_exr")
+        slots.append(_Slot(Layer("full reference", path, ins.linear(exr) if ins else None,
+                                 why=ins.why_not(exr) if ins else ""),
+                           "full reference (all light paths)", "expo ref-full"))
     for path, run in matched.items():
         ref = run.data.get("reference") if isinstance(run.data.get("reference"), dict) else {}
         detail = []
@@ -152,20 +252,29 @@ def _references_html(runs: list[Run], page: Page) -> str:
             detail.append(f"{int(num(ref.get('samples')))} spp")
         if num(ref.get("rel_error")) is not None:
             detail.append(f"rel. error {num(ref.get('rel_error')):.3g}")
-        cards.append(_reference_figure(path, page, run.reference_label() or "reference",
-                                       detail, "ref-matched"))
+        exr = run.reference_path("final_exr")
+        label = run.reference_label() or "reference"
+        slots.append(_Slot(Layer(label, path, ins.linear(exr) if ins else None,
+                                 why=ins.why_not(exr) if ins else ""),
+                           label + (f" ({', '.join(detail)})" if detail else ""),
+                           "expo ref-matched"))
     for path in indirect:
-        cards.append(_reference_figure(path, page, "full reference's indirect (full − emission "
-                                       "− direct)", [], "ref-indirect"))
-    if not cards:
+        slots.append(_Slot(Layer("full reference's indirect", path,
+                                 why="8-bit preview only (no EXR of this layer)"),
+                           "full reference's indirect (full − emission − direct)",
+                           "expo ref-indirect"))
+    if not slots:
         return ""
+    scene = runs[0].scene if runs else ""
+    cards = _slot_figures(slots, page, f"path-traced references of {scene}", REF_IMAGE_WIDTH,
+                          False, "reference")
     missing = [what for what, seen in (("the full reference image", full),
                                        ("the reference indirect layers", indirect)) if not seen]
     note = (f'<div class="muted">{" and ".join(missing)} '
             f'{"is" if len(missing) == 1 else "are"} not recorded by these runs (older results)'
             '</div>' if missing else "")
     return ('<div class="card refs" style="border-top-color:#000"><div class="card-title">'
-            'path-traced reference</div><div class="pair">' + "".join(cards) + "</div>"
+            'path-traced reference</div><div class="pair">' + cards + "</div>"
             + note + "</div>")
 
 
@@ -176,10 +285,10 @@ def _exposure_bar() -> str:
             '</label><output>+0.00 EV</output><button type="button" class="reset">reset</button>'
             '<span class="note">applied in the browser to the 8-bit sRGB previews as CSS '
             'brightness(2<sup>EV/2.2</sup>), which approximates a change of linear exposure '
-            'for mid-tones; clipped highlights stay clipped. FLIP maps are not affected. '
-            'The EXR files hold the linear values.</span>'
-            f'<span class="colorbar note">FLIP 0 <i style="background:linear-gradient(to right, '
-            f'{gradient})"></i> 1</span></div>')
+            'for mid-tones; clipped highlights stay clipped. Error maps are not affected. '
+            'The EXR files hold the linear values (shown by the inspector).</span>'
+            f'<span class="colorbar note">error maps 0 <i style="background:linear-gradient('
+            f'to right, {gradient})"></i> 1</span></div>')
 
 
 def _scene_resolution(runs: list[Run]) -> str:
@@ -215,20 +324,59 @@ def _direct_accuracy_line(runs: list[Run], page: Page) -> str:
             + doc_link(page, "shared_passes.md") + ").</p>")
 
 
+def ranked_bests(measured: list[Run], page: Page, scene: str) -> list[tuple[Run, int, str]]:
+    """Each technique's best run (of each reference group on the matched fallback) in rank
+    order on the scene's basis, with its rank and group; ranks count within a group (on the
+    full basis there is one group: every run is compared with the same reference)."""
+    basis = page.basis(scene)
+    bests = best_runs(measured, basis)
+    group = (lambda r: basis.group(r)) if basis.name == "matched" else (lambda r: "")
+    order = sorted(bests, key=lambda r: ((len(group(r)), group(r)), best_key(r, basis)))
+    out, seen = [], {}
+    for run in order:
+        seen[group(run)] = seen.get(group(run), 0) + 1
+        out.append((run, seen[group(run)], group(run)))
+    return out
+
+
+def _best_badge(best: Run, rivals: list[Run], page: Page, group: str) -> str:
+    """The one badge of a scene (of a reference group on the matched fallback): 'best', or
+    'best (tie)' when another technique's best run is within the error bars."""
+    basis = page.basis(best.scene)
+    ties = tied_best(best, [r for r in rivals if r.status == "ok"], basis.flip,
+                     basis.flip_sigma)
+    where = f" vs {group}" if group else ""
+    if not ties:
+        return (f'<span class="badge b-best" title="lowest {esc(basis.label("HDR-FLIP", group))}'
+                f' of every technique">best{esc(where)}</span>')
+    names = ", ".join(sorted({r.technique for r in ties}))
+    return (f'<span class="badge b-best b-tie" title="lowest {esc(basis.label("HDR-FLIP", group))}'
+            f', but {esc(names)} within the error bars">best{esc(where)} (tie)</span>')
+
+
 def scene_section(scene: str, runs: list[Run], page: Page) -> str:
     measured = [r for r in runs if r.measured]
     basis = page.basis(scene)
     cards = [_references_html(measured, page)]
     details = []
-    for best in best_runs(measured, basis):
-        group = [r for r in measured if r.technique == best.technique
-                 and basis.group(r) == basis.group(best)]
-        ties = tied_best(best, [r for r in group if r.status == "ok"], basis.flip,
+    ranked = ranked_bests(measured, page, scene)
+    winners: dict[str, Run] = {}
+    for run, _, group in ranked:
+        if run.status == "ok" and group not in winners:
+            winners[group] = run
+    for best, rank, group in ranked:
+        members = [r for r in measured if r.technique == best.technique
+                   and basis.group(r) == basis.group(best)]
+        ties = tied_best(best, [r for r in members if r.status == "ok"], basis.flip,
                          basis.flip_sigma)
-        cards.append(_card(best, page, best=True, lazy=False, ties=ties))
-        others = [r for r in group if r is not best]
+        badge = ""
+        if winners.get(group) is best:
+            rivals = [r for r, _, g in ranked if g == group and r is not best]
+            badge = _best_badge(best, rivals, page, group if len(winners) > 1 else "")
+        cards.append(_card(best, page, rank, badge, lazy=False, ties=ties))
+        others = sorted((r for r in members if r is not best), key=lambda r: best_key(r, basis))
         if others:
-            inner = "".join(_card(r, page, best=False, lazy=True, ties=[]) for r in others)
+            inner = "".join(_card(r, page, None, "", lazy=True, ties=[]) for r in others)
             details.append(f'<details><summary>show the other {len(others)} run'
                            f'{"s" if len(others) > 1 else ""} of {esc(best.technique)}</summary>'
                            f'<div class="cards">{inner}</div></details>')
@@ -255,11 +403,33 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
                   + (f' and timed by the <b class="clock">{esc(DYNAMIC_FRAME)}</b>; the images '
                      'are frame 0, every frame is in the <a href="#'
                      f'{animation_anchor(scene)}">animation section</a>'
-                     if dynamic_clock(measured) else "") + ".</p>")
+                     if dynamic_clock(measured) else "")
+                  + ". Cards in rank order (#1 first), each technique's best run; the badge "
+                  "marks the best of all.</p>")
     return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{basis_line}'
             f'{_direct_accuracy_line(measured, page)}'
             f'{_exposure_bar()}<div class="cards">{"".join(cards)}</div>{"".join(details)}'
             f'{note}</section>')
+
+
+def _inspector_words(page: Page) -> str:
+    """What the inspector does and how its values are embedded, with this page's numbers."""
+    ins = page.inspector
+    count = len(ins.images) if ins else 0
+    size = (ins.chars / 1024.0) if ins else 0.0
+    side = int(MAX_PIXELS ** 0.5)
+    skipped = (f" {ins.skipped_budget} more were left out: the page's budget of "
+               f"{BUDGET_CHARS // (1024 * 1024)} MiB for them is spent."
+               if ins and ins.skipped_budget else "")
+    return (f'<b>Click any image</b> to inspect it: nearest-neighbour zoom (+/−, 0 = fit), flip '
+            'between the run, the reference and the error maps of its card (keys 1–9, ← → or '
+            'space) and read the <b>linear values</b> under the cursor. The values come from '
+            'the runs\' and references\' EXR files, embedded in this page as float16 RGB '
+            f'(base64) for images of at most {side}×{side} pixels: {count} images, '
+            f'{size:,.0f} KiB.{skipped} The error map against the full reference is the '
+            'runner\'s HDR-FLIP map (<code>outputs.flip_full_png</code>) where it wrote one; '
+            f'else the report draws its own: {esc(RELERR_WORDS)}. A link '
+            '<code>report.html#inspect=&lt;run key&gt;</code> opens the inspector on a run.')
 
 
 def scenes_html(page: Page) -> str:
@@ -270,12 +440,14 @@ def scenes_html(page: Page) -> str:
     return ('<h2 id="images">Images</h2><p>Per scene: the path-traced references (the full one, '
             'with all light paths, and the bounce-matched ones the techniques claim), then each '
             'technique\'s best run — lowest mean HDR-FLIP against the <b>full reference</b> — '
-            'with its FLIP error map, its indirect layer next to the reference\'s matching '
-            'indirect layer, and a link to its linear EXR. The first number of a card is the '
-            'ranking basis; the bounce-matched error (the light paths the technique claims) '
-            'and the direct-light error (shared by every technique) follow, each labelled. '
-            '"best (tie)": another run of the technique is within the error bars. Click an '
-            'image for the full-size file.</p>' + body)
+            'in rank order, with its error map against the full reference first, then its '
+            'HDR-FLIP map against the bounce-matched reference (the light paths it claims), its '
+            'indirect layer next to the reference\'s matching indirect layer, and a link to its '
+            'linear EXR. The first number of a card is the ranking basis; the bounce-matched '
+            'error and the direct-light error (shared by every technique) follow, each '
+            'labelled. "best (tie)": another technique\'s best run is within the error '
+            f'bars.</p><p class="inspector-note">{_inspector_words(page)}</p>' + body)
+
 
 
 # ---------------------------------------------------------------------------------------------
@@ -302,14 +474,15 @@ def _front_table(front: list[Run], page: Page, scene: str, group: str, ties: dic
         mark = ("front" if tie is None else f"tie with {esc(params_text(tie, True)) or tie.technique}"
                 f" ({esc(tie.technique)})")
         rows.append(f'<tr data-key="{esc(run.key)}"><td>{swatch(run.technique, page)}</td>'
-                    f"<td class='params'>{params_html(run)}</td><td class='n'>"
-                    f"{with_bar(fmt_ms(run.frame_ms), run.frame_iqr, fmt_ms)}</td>"
+                    f"<td class='params'>{params_html(run)}</td><td class='n c-time'>"
+                    f"{time_with_bar(run.frame_ms, run.frame_iqr)}</td>"
                     f'<td class="n" data-key="{esc(run.key)}" data-basis="{esc(basis.name)}" '
                     f'data-v="{basis.flip(run)!r}">'
                     f"{with_bar(fmt_flip(basis.flip(run)), basis.flip_sigma(run), fmt_flip)}</td>"
                     f"<td>{mark}</td></tr>")
     measured = [r for r in compared if r.measured]
     return (f'<table class="data ranking" data-basis="{esc(basis.name)}" data-value="error">'
+            f'<caption class="device-line">timed on {esc(device_names(measured))}</caption>'
             f'<thead><tr><th>technique</th><th>parameters</th>'
             f'<th>{esc(time_label(measured, "frame time"))} ± IQR</th>'
             f'<th>mean {esc(basis.label("HDR-FLIP", group))}</th><th>on the front</th></tr>'
@@ -412,16 +585,28 @@ def pareto_html(page: Page) -> str:
         parts.append(f"<h3>{esc(scene)}</h3>")
         runs = scenes.get(scene, [])
         several = len(device_groups(_timed(runs))) > 1
+        noisy = [r for r in _timed(runs) if noisy_run(r)]
         parts.append(figure_html(path, page, f"error vs frame time, {scene}",
                                  f"{'Top two rows' if several else 'Top row'}: "
                                  f"{esc(basis.label('HDR-FLIP'))} "
                                  f"{'and' if several else '(left) and'} "
                                  f"{esc(basis.label('relMSE'))}{'' if several else ' (right)'} "
                                  f"against median frame time on {esc(scene)}."
-                                 + _devices_caption(runs)))
+                                 + _devices_caption(runs)
+                                 + (f" Timed on {esc(device_names(_timed(runs)))}."
+                                    if not several else "")
+                                 + (f" {_noisy_figure_note(len(noisy))}" if noisy else "")))
         parts.append(_mixed_references_note(runs, page, scene))
         parts.append(_front_tables(page, scene, runs))
     return "".join(parts)
+
+
+def _noisy_figure_note(count: int) -> str:
+    """The caption's word on the noisy-timing marker of a figure."""
+    return (f'<span class="noisy">\u26a0 {count} noisy timing{"s" if count != 1 else ""}</span>'
+            f' (a red square in the figure: frame-time IQR above {NOISY_PERCENT} % of its '
+            'median, '
+            'see <a href="#noisy-timings">noisy timings</a>).')
 
 
 def _series_name(sweep: Sweep, others: tuple) -> str:
@@ -444,7 +629,11 @@ def sweep_summary(sweep: Sweep, page: Page) -> str:
                      f"{esc(text(param_value(first, sweep.key)))} to "
                      f"{esc(text(param_value(last, sweep.key)))}, "
                      f"{esc(basis.label('HDR-FLIP'))} {esc(error)}; frame time "
-                     f"{esc(time_change_words(first, last, fmt_ms))}</li>")
+                     f"{esc(time_change_words(first, last, fmt_ms))}"
+                     + "".join(f" ({esc(sweep.key)}={esc(text(param_value(r, sweep.key)))}:"
+                               f"{noisy_mark(r.frame_ms, r.frame_iqr)})" for r in (first, last)
+                               if noisy_run(r))
+                     + "</li>")
     return f'<ul class="trend">{"".join(items)}</ul>' if items else ""
 
 
@@ -468,14 +657,23 @@ def sweeps_html(page: Page) -> str:
              'only called a rise or a fall when the error bars (error) or the IQRs (time) of '
              'the two ends do not overlap. A parameter whose runs give identical images is '
              'reported as having no effect on the scene.</p>']
+    all_sweeps = [s for s, _ in page.figures.sweeps] + [s for s, _ in page.figures.no_effect]
     for sweep, path in page.figures.sweeps:
         n = sum(len(m) for m in sweep.series.values())
         others = (f"; one line per {esc(', '.join(sweep.other_keys))}" if sweep.other_keys
                   else "")
+        apart = {s.keys for s in all_sweeps if s.technique == sweep.technique
+                 and s.scene == sweep.scene}
+        alone = (f" One of {len(apart)} separate sweeps of {esc(sweep.technique)} on this "
+                 f"scene; this one sweeps {esc(' × '.join(sweep.keys))} only."
+                 if len(apart) > 1 else "")
+        noisy = [r for m in sweep.series.values() for r in m if r.measured and noisy_run(r)]
+        flag = (f" {_noisy_figure_note(len(noisy))}" if noisy else "")
         parts.append(figure_html(
             path, page, f"sweep {sweep.technique} {sweep.scene} {sweep.key}",
             f"{swatch(sweep.technique, page)} on {esc(sweep.scene)}: "
-            f"<b>{esc(sweep.key)}</b> ({n} runs{others})." + sweep_summary(sweep, page)))
+            f"<b>{esc(sweep.key)}</b> ({n} runs{others}).{alone}{flag}"
+            + sweep_summary(sweep, page)))
     parts.append(no_effect_html(page))
     return "".join(parts)
 
@@ -487,10 +685,19 @@ def passes_html(page: Page) -> str:
     parts = ['<h2 id="passes">Time per pass</h2><p>For each technique\'s best run per scene: '
              f'the median time of every pass of a frame on {esc(device)}, stacked (left), and '
              'the one-time set-up cost by stage, wall clock (right). Totals above the bars.</p>']
+    scenes = by_scene(page.results.runs)
     for scene, path in page.figures.passes.items():
         parts.append(f"<h3>{esc(scene)}</h3>")
+        best = best_runs(scenes.get(scene, []), page.basis(scene))
+        noisy = any(noisy_time(t.median, t.iqr) for r in best for _, t in r.pass_times()) or \
+            any(noisy_time(r.static.median, r.static.iqr) for r in best)
+        flag = (' <span class="noisy">\u26a0 noisy timings</span> are marked: a hatched pass '
+                f'has an IQR above {NOISY_PERCENT} % of its median; a total with * is a frame '
+                'time whose IQR is (see <a href="#noisy-timings">noisy timings</a>).'
+                if noisy else "")
         parts.append(figure_html(path, page, f"time per pass, {scene}",
-                                 f"Per-pass time ({esc(device)}) and set-up time on {esc(scene)}."))
+                                 f"Per-pass time ({esc(device)}) and set-up time on {esc(scene)}"
+                                 f", timed on {esc(device_names(best))}.{flag}"))
     return "".join(parts)
 
 
@@ -498,16 +705,42 @@ def passes_html(page: Page) -> str:
 # The page
 # ---------------------------------------------------------------------------------------------
 
-NAV_TITLES = (("images", "Images"), ("animation", "Animation"), ("runs", "All runs"), ("pareto", "Error vs. time"),
-              ("sweeps", "Sweeps"), ("passes", "Time per pass"), ("equal", "Equal time/error"),
-              ("skipped", "Skipped passes"), ("unreadable", "Unreadable"),
-              ("definitions", "Definitions"))
+NAV_TITLES = (("equal", "Equal time/error"), ("images", "Images"), ("animation", "Animation"),
+              ("runs", "All runs"), ("pareto", "Error vs. time"), ("sweeps", "Sweeps"),
+              ("passes", "Time per pass"), ("skipped", "Skipped passes"),
+              ("unreadable", "Unreadable"), ("definitions", "Definitions"))
+
+
+def inspector_html(page: Page) -> str:
+    """The inspector's (hidden) overlay and its data; '' when no image can be inspected."""
+    ins = page.inspector
+    if ins is None or not ins.groups:
+        return ""
+    payload = ins.payload(lambda path: rel_url(path, page.out_dir))
+    return ('<div id="inspector" class="inspector" hidden role="dialog" '
+            'aria-label="image inspector" tabindex="-1"><div class="ins-bar">'
+            '<b class="ins-title"></b><span class="ins-layers"></span>'
+            '<span class="ins-zoom"><button type="button" data-zoom="out" title="zoom out (−)">'
+            '−</button><output class="ins-factor">1×</output><button type="button" '
+            'data-zoom="in" title="zoom in (+)">+</button><button type="button" data-zoom="fit" '
+            'title="fit (0)">fit</button></span><a class="ins-file" href="#">open the file</a>'
+            '<button type="button" class="ins-close" title="close (Esc)">close</button></div>'
+            '<div class="ins-view"><img class="ins-img" alt="" draggable="false"></div>'
+            '<div class="ins-status"><span class="ins-pos">move the cursor over the image'
+            '</span> <span class="ins-value"></span><div class="ins-more"></div></div>'
+            '<div class="ins-help">keys: 1–9 a layer · ← → or space: previous / next layer · '
+            '+ / −: zoom (nearest neighbour) · 0: fit · Esc: close. Values: linear RGB from the '
+            'EXR files (float16, so about 3 significant digits); error maps are colours (the '
+            'FLIP value is not stored), except the report\'s own map, whose value is computed '
+            'from the linear images.</div></div>'
+            f'<script type="application/json" id="gilab-inspector">{payload}</script>'
+            '<pre id="inspector-selftest-result" hidden></pre>')
 
 
 def render_page(page: Page) -> str:
-    sections = [invalid_banner_html(page), scenes_html(page), animation_html(page),
-                run_table_html(page) + failures_html(page), pareto_html(page),
-                sweeps_html(page), passes_html(page), equal_html(page), skipped_html(page),
+    sections = [invalid_banner_html(page), equal_html(page), scenes_html(page),
+                animation_html(page), run_table_html(page) + failures_html(page),
+                pareto_html(page), sweeps_html(page), passes_html(page), skipped_html(page),
                 unreadable_html(page)]
     body = "".join(sections)
     if not page.results.runs:
@@ -522,4 +755,4 @@ def render_page(page: Page) -> str:
             f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
             f"<title>{esc(title)}</title><style>{CSS}</style><script>{HEAD_JS}</script></head>"
             f"<body>{header_html(page)}<nav>{nav}</nav>{body}{footer_html(page)}"
-            f"<script>{BODY_JS}</script></body></html>\n")
+            f"{inspector_html(page)}<script>{BODY_JS}{INSPECTOR_JS}</script></body></html>\n")

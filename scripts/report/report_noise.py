@@ -14,6 +14,21 @@ from report_data import Run
 
 Metric = Callable[[Run], Optional[float]]
 
+# A timing whose interquartile range is above this fraction of its median is flagged as noisy
+# wherever it is shown (docs/report.md, "Noisy timings").
+NOISY_IQR_FRACTION = 0.10
+
+
+def noisy_time(median: Optional[float], iqr: Optional[float]) -> bool:
+    """Whether a timing's IQR is above NOISY_IQR_FRACTION of its median."""
+    return (median is not None and iqr is not None and median > 0
+            and iqr > NOISY_IQR_FRACTION * median)
+
+
+def noisy_run(run: Run) -> bool:
+    """Whether the frame time a run is ranked by is noisy."""
+    return noisy_time(run.frame_ms, run.frame_iqr)
+
 
 def time_interval(run: Run) -> tuple[float, float]:
     """[q1, q3] of the frame time (the median where a quartile is missing)."""

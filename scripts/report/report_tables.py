@@ -11,12 +11,14 @@ from typing import Callable, Optional
 from report_analysis import (MIN_COMPARED, best_within_budget, by_device, by_scene,
                              by_technique, cheapest_reaching, comparable_groups, error_targets,
                              ordered_unique, params_text, slug, time_budgets)
-from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html, fmt_fixed,
-                           fmt_flip, fmt_ms, fmt_sig, nonfinite_count, params_html, rel_url,
-                           status_badge, swatch, update_badge, validation_summary, with_bar)
+from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html,
+                           fmt_fixed, fmt_flip, fmt_ms, fmt_sig, noisy_mark, nonfinite_count,
+                           params_html, rel_url, status_badge, swatch, time_with_bar,
+                           update_badge, validation_summary, with_bar)
 from report_data import Results, Run, dig, num, text
-from report_device import device_group, device_groups, device_note_html, time_label
-from report_noise import error_separable, time_separable
+from report_device import (device_group, device_groups, device_names, device_note_html,
+                           time_label)
+from report_noise import NOISY_IQR_FRACTION, error_separable, noisy_time, time_separable
 
 
 # ---------------------------------------------------------------------------------------------
@@ -79,12 +81,47 @@ def header_html(page: Page) -> str:
     note = device_note_html([r for r in runs if r.measured])
     if note:
         rows.append(("timings", f'<span class="device-note">{note}</span>'))
+    noisy = noisy_summary(page)
+    if noisy:
+        rows.append(("noisy timings", noisy))
     rows.append(("results", "<br>".join(esc(d) for d in res.dirs)))
     rows.append(("runs", counts_html(page)))
     meta = "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows)
     desc = "".join(f'<p class="lead">{esc(d)}</p>' for d in descriptions)
     return (f"<header><h1>gilab report — {esc(experiment_name(res))}</h1>{desc}"
             f'<table class="meta">{meta}</table></header>')
+
+
+def noisy_timings(runs: list[Run]) -> list[tuple[Run, str, float, float]]:
+    """(run, what, median, IQR) of every frame time of the measured runs whose IQR is above
+    NOISY_IQR_FRACTION of its median: the static frame and, on animated scenes, the dynamic
+    one."""
+    out = []
+    for run in runs:
+        if not run.measured:
+            continue
+        times = [("frame time", run.static)]
+        if run.anim is not None:
+            times.append(("dynamic frame time", run.anim.dynamic))
+        out += [(run, what, t.median, t.iqr) for what, t in times
+                if noisy_time(t.median, t.iqr)]
+    return out
+
+
+def noisy_summary(page: Page) -> str:
+    """The header's line on noisy frame times ('' when none)."""
+    runs = page.results.runs
+    noisy = noisy_timings(runs)
+    if not noisy:
+        return ""
+    timed = sum(1 for r in runs if r.measured and r.static.median is not None)
+    items = ", ".join(f"{esc(r.technique)} on {esc(r.scene)} ({what} {fmt_ms(m)} ± {fmt_ms(i)} "
+                      f"ms, IQR {100 * i / m:.0f} %)" for r, what, m, i in noisy[:8])
+    more = f" and {len(noisy) - 8} more" if len(noisy) > 8 else ""
+    return (f'<span class="noisy">\u26a0 {len(noisy)} noisy timing'
+            f'{"s" if len(noisy) != 1 else ""}</span> of {timed} timed runs: {items}{more}. '
+            f"Their IQR is above {100 * NOISY_IQR_FRACTION:.0f} % of the median; each is marked "
+            '\u26a0 in every table and figure (<a href="#noisy-timings">why</a>).')
 
 
 def _instrumentation(page: Page) -> str:
@@ -156,11 +193,12 @@ def _region_columns(runs: list[Run]) -> list[Column]:
 
 
 def _passes_cell(run: Run) -> tuple[str, object]:
-    passes = run.passes()
+    passes = run.pass_times()
     if not passes:
         return DASH, None
-    total = sum(v for _, v in passes if v is not None)
-    body = " · ".join(f'<span class="pass">{esc(n)}&nbsp;{fmt_ms(v)}</span>' for n, v in passes)
+    total = sum(t.median for _, t in passes if t.median is not None)
+    body = " · ".join(f'<span class="pass">{esc(n)}&nbsp;{fmt_ms(t.median)}'
+                      f'{noisy_mark(t.median, t.iqr, True)}</span>' for n, t in passes)
     return body, total
 
 
@@ -178,7 +216,7 @@ def _memory_cell(run: Run) -> tuple[str, object]:
 def _frame_cell(run: Run) -> tuple[str, object]:
     """The static frame (on an animated scene too: the dynamic one has its own column)."""
     frame = run.static
-    shown = with_bar(fmt_ms(frame.median), frame.iqr, fmt_ms)
+    shown = time_with_bar(frame.median, frame.iqr)
     if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
     return shown, frame.median
@@ -188,7 +226,7 @@ def _dynamic_cell(run: Run) -> tuple[str, object]:
     frame = run.anim.dynamic if run.anim is not None else None
     if frame is None or frame.median is None:
         return DASH, None
-    shown = with_bar(fmt_ms(frame.median), frame.iqr, fmt_ms)
+    shown = time_with_bar(frame.median, frame.iqr)
     if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
     return shown, frame.median
@@ -418,6 +456,8 @@ def run_table_html(page: Page) -> str:
             '<div class="filter">filter <input id="run-filter" type="search" '
             'placeholder="scene, technique, parameter, status…"> '
             f'<span id="run-count" class="muted">{len(runs)} of {len(runs)}</span></div>'
+            f'<p class="device-line">Timed on {esc(device_names([r for r in runs if r.measured]))}'
+            '.</p>'
             f'<div class="table-wrap"><table id="run-table" class="data sortable"><thead><tr>'
             f'{head}</tr></thead><tbody>{"".join(rows)}</tbody></table></div>')
 
@@ -481,6 +521,7 @@ class Ranking:
     basis_name: str
     corner: str  # the header of the first column (names the basis / device)
     shows: str  # "error" or "time": what the cells' data-v holds
+    device: str = ""  # the device model(s) the times were measured on (the table's caption)
 
 
 def _equal_table(page: Page, runs: list[Run], table: Ranking) -> str:
@@ -509,9 +550,11 @@ def _equal_table(page: Page, runs: list[Run], table: Ranking) -> str:
                          f'title="{esc(params_text(run))}">{table.show(run)}{mark}</td>')
         rows.append(f"<tr><td>{swatch(tech, page)}</td>{''.join(cells)}</tr>")
     head = "".join(f'<th>{esc(h)}</th>' for h in table.headers)
+    caption = (f'<caption class="device-line">timed on {esc(table.device)}</caption>'
+               if table.device else "")
     return (f'<table class="data ranking" data-basis="{esc(table.basis_name)}" '
-            f'data-value="{table.shows}"><thead><tr><th>{esc(table.corner)}</th>{head}</tr></thead>'
-            f'<tbody>{"".join(rows)}</tbody></table>')
+            f'data-value="{table.shows}">{caption}<thead><tr><th>{esc(table.corner)}</th>{head}'
+            f'</tr></thead><tbody>{"".join(rows)}</tbody></table>')
 
 
 def _equal_group_html(page: Page, ok: list[Run], scene: str, group: str) -> str:
@@ -523,14 +566,17 @@ def _equal_group_html(page: Page, ok: list[Run], scene: str, group: str) -> str:
     frame = time_label(ok, "frame time")
     error_tied = lambda a, b: not error_separable(a, b, basis.flip, basis.flip_sigma)  # noqa
     time_tied = lambda a, b: not time_separable(a, b)  # noqa: E731
+    device = device_names(ok)
     equal_time = Ranking([f"≤ {b:g} ms" for b in budgets],
                          lambda rs, i: best_within_budget(rs, budgets[i], basis),
                          lambda r: fmt_flip(basis.flip(r)), basis.flip, error_tied, basis.name,
-                         f"mean {flip_label}, by {frame} budget", "error")
+                         f"mean {flip_label}, by {frame} budget", "error", device)
     equal_error = Ranking([f"≤ {t:g}" for t in targets],
                           lambda rs, i: cheapest_reaching(rs, targets[i], basis),
-                          lambda r: fmt_ms(r.frame_ms), lambda r: r.frame_ms, time_tied,
-                          basis.name, f"{frame}, by mean {flip_label} target", "time")
+                          lambda r: fmt_ms(r.frame_ms) + noisy_mark(r.frame_ms, r.frame_iqr,
+                                                                    True),
+                          lambda r: r.frame_ms, time_tied,
+                          basis.name, f"{frame}, by mean {flip_label} target", "time", device)
     return (f'<h4>Equal time: lowest mean <span class="basis">{esc(flip_label)}</span> within a '
             f'budget of {esc(frame)}</h4>' + _equal_table(page, ok, equal_time)
             + f'<h4>Equal error: shortest {esc(frame)} reaching a mean <span class="basis">'
@@ -564,7 +610,8 @@ def equal_html(page: Page) -> str:
             parts += [f"<h3>{esc(scene)}</h3>"] + tables
     if not parts:
         return ""
-    return ('<h2 id="equal">Equal-time and equal-error comparison</h2><p>Per scene, every run '
+    return ('<h2 id="equal">Which technique is best? Equal-time and equal-error comparison'
+            '</h2><p>The cross-technique answer, per scene: every run '
             'is compared on the scene\'s one ranking basis, named in each heading: mean HDR-FLIP '
             'against the <b>full reference</b> (all light paths) where measured; results without '
             'it are compared only with runs of the same bounce-matched reference. Budgets are '
@@ -573,7 +620,10 @@ def equal_html(page: Page) -> str:
             'digits). Each cell is the technique\'s best ok run under that constraint (hover '
             'for its parameters); the best cell of each column is highlighted, and cells that '
             'cannot be told apart from it (error bars or frame-time IQRs overlap) are marked '
-            f'"(tie)"; {DASH} = no run qualifies.</p>' + "".join(parts))
+            f'"(tie)"; {DASH} = no run qualifies; \u26a0 marks a noisy frame time (IQR above '
+            f'{100 * NOISY_IQR_FRACTION:.0f} % of the median). Each table names the device its '
+            'times were measured on. The images, every run and the figures follow.</p>'
+            + "".join(parts))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -639,6 +689,15 @@ def footer_html(page: Page) -> str:
          "axis and header (\u201clavapipe (CPU)\u201d: Vulkan on the llvmpipe CPU rasteriser, "
          "not a GPU); ± is the interquartile range (q3 − q1). Runs without timestamps use the "
          "CPU frame time, marked (CPU clock). See " + doc_link(page, "timing.md") + "."),
+        ('<span id="noisy-timings">Noisy timings</span>', "a timing whose interquartile range "
+         f"is above {100 * NOISY_IQR_FRACTION:.0f} % of its median is marked \u26a0 noisy "
+         "wherever it is shown (image cards, the run table's frame, dynamic-frame and pass "
+         "times, the Pareto and equal-error tables, the animated-scene cost tables) and drawn "
+         "with a red square in the error-against-time and sweep figures (hatched in the "
+         "time-per-pass figure, its total starred). Its median is uncertain by about the IQR: two such "
+         "times are only told apart when their IQRs do not overlap (see Noise). Timing more "
+         "frames (the runner's timed frames) narrows it; on lavapipe (a CPU shared with other "
+         "work) frame times are often noisy."),
         ("Set-up time", "wall clock of the one-time set-up (scene upload, shared passes, "
          "shadow maps, technique set-up), <code>timing.setup_ms.total</code>."),
         ("Memory", "bytes of device memory allocated through gilab's accounting, in MiB "

@@ -47,7 +47,7 @@ std::vector<ParamSpec> cvgiParamSpecs() {
                  "Gaussian kernel width, odd (paper 5; 3 evaluated); 0 or 1 = no filtering"),
         intParam("gaussian_passes", 2, 0, 4, "", "Gaussian passes (paper 2)"),
         floatParam("gaussian_sigma_voxels", 1.0, 0.1, 8.0, "voxels",
-                   "Gaussian standard deviation (not given; notes 000 §8.10)"),
+                   "Gaussian standard deviation (not given in the paper; docs/techniques/cvgi.md)"),
         boolParam("gaussian_visibility", true,
                   "ours: a neighbour's face enters the Gaussian only if the straight path between "
                   "the two faces' front cells crosses no occupied voxel (false = the paper's "

@@ -20,7 +20,9 @@ std::vector<ParamSpec> dvsParamSpecs() {
         intParam("voxel_resolution", 128, VoxelGrid::kMinResolution, VoxelGrid::kMaxResolution,
                  "voxels", "voxels per grid axis N (source repo default 256)", kRebuild),
         enumParam("voxel_lambert", "normal_weighted", {"normal_weighted", "cosine"},
-                  "per-voxel diffuse term: notes 003 E1-E3 or plain max(N.Psi, 0)", kRebuild),
+                  "per-voxel diffuse term: normal_weighted = the paper's per-axis weighting "
+                  "(docs/dvs.md) | cosine = plain max(N.Psi, 0)",
+                  kRebuild),
         enumParam("voxel_shadows", "shadow_map", {"shadow_map", "raycast", "raycast_soft"},
                   "per-voxel occlusion: shared shadow maps | hard voxel ray | soft ray (E4)",
                   kRebuild),

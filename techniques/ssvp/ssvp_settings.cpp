@@ -46,7 +46,8 @@ std::vector<ParamSpec> ssvpParamSpecs() {
         floatParam("paraboloid_max_edge_deg", 15.0, 1.0, 180.0, "deg",
                    "split triangles until each edge subtends at most this from the eye"),
         floatParam("centroid_offset", 0.001, 0.0, 0.1, "scene diagonals",
-                   "paraboloid eye = centroid + offset x cluster normal (notes 002 §9)"),
+                   "paraboloid eye = centroid + offset x cluster normal (not given in the paper; "
+                   "docs/techniques/ssvp.md)"),
         enumParam("map_eye", "centroid", {"centroid", "nearest_vpl"},
                   "paraboloid map eye: the cluster centroid (paper) | the member VPL nearest "
                   "to it (never inside geometry or in the air)"),

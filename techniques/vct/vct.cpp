@@ -122,8 +122,9 @@ TechniqueInfo VctTechnique::describe() {
                    "full apex angle of each diffuse cone"),
         floatParam("diffuse_tilt_deg", 60.0, 0.0, 89.0, "deg",
                    "angle of the ring cones from the normal"),
-        floatParam("step_factor", 0.5, 0.05, 2.0, "",
-                   "cone step d' = step_factor x cone diameter (notes 001 §8)"),
+        floatParam(
+            "step_factor", 0.5, 0.05, 2.0, "",
+            "cone step d' = step_factor x cone diameter (the paper does not fix it; docs/vct.md)"),
         floatParam("max_distance", 1.0, 0.01, 2.0, "grid sides",
                    "maximum cone length in units of the voxel grid's side"),
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",

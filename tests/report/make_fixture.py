@@ -17,7 +17,12 @@ Contents (schema 1, see scripts/report/report_data.py for what the report reads)
               bounces), regions, energy_ratio; key names as experiments/metrics toJson writes them
   images      tiny PNGs: references/<scene>/<matched>.png ('+' in names), full.png (the full
               reference) and <name>.indirect.png (reference minus emission+direct), and
-              final/indirect/flip PNGs per run; the EXR files are placeholders (magic number only)
+              final/indirect/flip PNGs per run; on cornell_box also flip_full.png (the FLIP map
+              against the full reference, outputs.flip_full_png, as a newer runner would write)
+  EXR files   real OpenEXR (fixture_exr.py): each run's output.exr (ZIP, FLOAT layers final,
+              indirect, direct and R, G, B) and each reference's <name>.exr (NONE, FLOAT final,
+              HALF final_stderr), linear = (the PNG's value)^2.2, the light 12x brighter (HDR),
+              NaN where the PNG is magenta; the animated scene's frames have no EXR
   animated    "cornell_box#moving_light" (48x48, a light moving across the box; 9 frames, 5
               measured): tech_a (cone_count 4 and 16, update "incremental"; the 16-cone run's
               temporal instability is within the noise floor) and tech_b (update "full
@@ -27,10 +32,14 @@ Contents (schema 1, see scripts/report/report_data.py for what the report reads)
   device      lavapipe (device.type "cpu"), as the project's own results
   no-op sweep direct sweeps shared.area_light_samples (4, 16): it changes cornell_box (area
               light) and nothing on sponza#sun (identical images and metrics)
+  two sweeps  direct also sweeps shared.pcf_radius (0, 1) on cornell_box, a separate sweep
+              (its runs' technique.swept holds only that key)
+  noisy time  frame-time IQR 35 % of the median (tech_a, 2 cones, cornell_box), 15 % (tech_b
+              64 x 8) and 8 % (tech_a, 8 cones: under the report's 10 % threshold)
 With --no-sweeps: every technique has one run per scene and nothing is swept, and there are no
 regions, no error bars, no final_vs_full, no metrics.direct, no full reference or reference
-indirect layers (an older runner), no animated scene, and the device is a GPU (for checking that
-those parts are left out or labelled accordingly).
+indirect layers (an older runner), no animated scene, placeholder EXR files (magic number only)
+and the device is a GPU (for checking that those parts are left out or labelled accordingly).
 The numbers are made up but consistent: more cones / voxels / steps = lower error, more time.
 """
 from __future__ import annotations
@@ -49,6 +58,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import fixture_exr  # noqa: E402
 
 SCENES = {"cornell_box": (64, 64), "sponza#sun": (96, 64)}
 # The animated scene (main fixture only): a light moving across a Cornell box.
@@ -110,6 +122,10 @@ def run_specs(sweeps: bool) -> list[Spec]:
             specs.append(Spec(scene, "direct", {}, ["shared.area_light_samples"] if sweeps else [],
                               notes=["direct: baseline: indirect layer is zero by construction"],
                               shared={"area_light_samples": n}))
+        for radius in ((0, 1) if sweeps and scene == "cornell_box" else ()):
+            specs.append(Spec(scene, "direct", {}, ["shared.pcf_radius"],  # a second sweep
+                              notes=["direct: baseline: indirect layer is zero by construction"],
+                              shared={"pcf_radius": radius}))
         for n in cones:
             bad = sweeps and scene == "sponza#sun" and n == 16
             specs.append(Spec(scene, "tech_a", {"cone_count": n, "max_distance": 1.5}, swept_a,
@@ -157,6 +173,8 @@ def flip_of(spec: Spec) -> float:
     if spec.technique == "direct":  # against the emission+direct reference: small error
         samples = spec.shared.get("area_light_samples", 16)
         base = 0.06 + (0.08 / samples if area_lit(spec.scene) else 0.0)
+        if "pcf_radius" in spec.shared:  # softer shadow filtering: a little more error
+            base += 0.003 * (1 + spec.shared["pcf_radius"])
     elif spec.technique == "tech_a":
         base = 0.05 + 0.20 / math.sqrt(p["cone_count"])
     else:
@@ -196,8 +214,25 @@ def pass_times(spec: Spec) -> list[tuple[str, float]]:
     return passes
 
 
-def summary(median: float, rng: np.random.Generator, count: int = 5) -> dict:
+# Frame-time IQRs set on purpose (fraction of the median): a noisy run, one noisy by a smaller
+# margin, and one just under the report's 10 % threshold (not flagged).
+SPREADS = {("cornell_box", "tech_a", 2): 0.35, ("cornell_box", "tech_b", 64, 8): 0.15,
+           ("cornell_box", "tech_a", 8): 0.08}
+
+
+def spread(spec: Spec) -> Optional[float]:
+    key = (spec.scene, spec.technique) + tuple(
+        spec.params[k] for k in ("cone_count", "voxel_res", "steps") if k in spec.params)
+    return SPREADS.get(key)
+
+
+def summary(median: float, rng: np.random.Generator, count: int = 5,
+            iqr: Optional[float] = None) -> dict:
+    """Five samples around the median; with iqr, quartiles (1 - 0.4 iqr) and (1 + 0.6 iqr) x
+    the median (an IQR of iqr x the median)."""
     samples = sorted(median * (1.0 + rng.normal(0.0, 0.04, count)))
+    if iqr is not None:
+        samples = [median * (1.0 + f * iqr) for f in (-0.8, -0.4, 0.0, 0.6, 1.2)]
     samples[count // 2] = median
     q1, q3 = float(np.percentile(samples, 25)), float(np.percentile(samples, 75))
     return {"median": median, "q1": q1, "q3": q3, "iqr": q3 - q1, "min": min(samples),
@@ -319,6 +354,8 @@ def technique_images(spec: Spec, flip: float, rng: np.random.Generator, t: float
         noisy = np.zeros_like(indirect)
         samples = spec.shared.get("area_light_samples", 16)
         direct = direct * (0.94 - (0.2 / samples if area_lit(spec.scene) else 0.0))
+        if "pcf_radius" in spec.shared:
+            direct = direct * (0.98 - 0.02 * spec.shared["pcf_radius"])
     else:
         noisy = indirect * (1.0 - flip) + rng.normal(0.0, flip * 0.12, indirect.shape)
     if spec.technique == "tech_b":  # blocky, like a coarse voxel grid
@@ -331,6 +368,24 @@ def technique_images(spec: Spec, flip: float, rng: np.random.Generator, t: float
         idx = rng.choice(final.shape[0] * final.shape[1], spec.nan_pixels, replace=False)
         final.reshape(-1, 3)[idx] = (1.0, 0.0, 1.0)
     return final, np.clip(noisy, 0, 1), error
+
+
+def linear(image: np.ndarray) -> np.ndarray:
+    """The linear values behind a display image: value^2.2, the light (near-white pixels) 12x
+    brighter than white, NaN where the image is magenta (a non-finite pixel)."""
+    out = np.power(np.clip(image, 0.0, 1.0), 2.2).astype(np.float32)
+    light = (image.min(axis=2) > 0.88)
+    out[light] *= 12.0
+    magenta = (image[..., 0] == 1.0) & (image[..., 1] == 0.0) & (image[..., 2] == 1.0)
+    out[magenta] = np.nan
+    return out
+
+
+def write_reference_exr(path: str, image: np.ndarray) -> None:
+    """A reference's EXR: final (FLOAT) and final_stderr (HALF), uncompressed."""
+    lin = linear(image)
+    fixture_exr.write_exr(path, {"final": lin, "final_stderr": lin * 0.01},
+                          compression=fixture_exr.NONE, half=("final_stderr",))
 
 
 def write_png(path: str, image: np.ndarray, cmap: Optional[str] = None) -> None:
@@ -361,7 +416,7 @@ LAVAPIPE = {"name": "llvmpipe (LLVM 15.0.6, 256 bits)", "type": "cpu", "driver":
             "driver_info": "Mesa 22.3.6 (LLVM 15.0.6)", "vulkan_api": "1.3.230"}
 GPU = {"name": "Fixture GPU (synthetic)", "type": "discrete", "driver": "fixture",
        "driver_info": "synthetic 1.0", "vulkan_api": "1.3.280"}
-EXR_MAGIC = b"v/1\x01"  # the fixture's EXR files are placeholders: magic number only
+EXR_MAGIC = b"v/1\x01"  # the flat fixture's EXR files are placeholders: magic number only
 
 
 def direct_energy(scene: str) -> float:
@@ -415,7 +470,8 @@ def timing_json(spec: Spec, rng: np.random.Generator) -> dict:
     timing = {"policy": "docs/timing.md: warm-up discarded; median and IQR over timed frames",
               "setup_ms": setup, "setup_gpu_passes": [{"name": "shadow_maps", "gpu_ms": 108.2}],
               "warmup_frames": 2, "timed_frames": 5,
-              "frame_cpu_ms": summary(gpu + 0.3, rng), "frame_gpu_ms": summary(gpu, rng),
+              "frame_cpu_ms": summary(gpu + 0.3, rng),
+              "frame_gpu_ms": summary(gpu, rng, iqr=spread(spec)),
               "passes": [{"name": n, "gpu_ms": summary(v, rng),
                           "cpu_record_ms": summary(0.01, rng)} for n, v in passes]}
     if spec.update:  # an animated scene: the frame after the light moved, update included
@@ -475,6 +531,10 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
         write_png(os.path.join(folder, "final.png"), final)
         write_png(os.path.join(folder, "indirect.png"), indirect)
         write_png(os.path.join(folder, "flip.png"), error, cmap="magma")
+        if sweeps and spec.scene == "cornell_box":  # a newer runner's map vs the full reference
+            full = reference_image(spec.scene, FULL_BOUNCES)
+            write_png(os.path.join(folder, "flip_full.png"),
+                      np.clip(np.abs(final - full).mean(axis=2) * 3.0, 0, 1), cmap="magma")
         metrics = {"final": metric_set(flip, w * h, bars, spec.nan_pixels)}
         if sweeps:  # the runner writes it; the flat fixture checks the report without it
             metrics["final_vs_full"] = metric_set(flip_vs_full(spec), w * h, bars,
@@ -506,10 +566,18 @@ def write_run(root: str, spec: Spec, sweeps: bool, rng: np.random.Generator) -> 
                 "full_exr": f"../../references/{label}/{FULL}.exr",
                 "indirect_png": f"../../references/{label}/{matched}.indirect.png",
                 "indirect_full_png": f"../../references/{label}/{FULL}.indirect.png"})
-        with open(os.path.join(folder, "output.exr"), "wb") as f:
-            f.write(EXR_MAGIC)
+        if sweeps:
+            final_lin, indirect_lin = linear(final), linear(indirect)
+            fixture_exr.write_exr(os.path.join(folder, "output.exr"), {
+                "": final_lin, "final": final_lin, "indirect": indirect_lin,
+                "direct": np.maximum(np.nan_to_num(final_lin - indirect_lin), 0.0)})
+        else:  # an older runner's folder: a placeholder
+            with open(os.path.join(folder, "output.exr"), "wb") as f:
+                f.write(EXR_MAGIC)
         outputs = {"exr": "output.exr", "final_png": "final.png",
                    "indirect_png": "indirect.png", "flip_png": "flip.png"}
+        if sweeps and spec.scene == "cornell_box":
+            outputs["flip_full_png"] = "flip_full.png"
         if spec.update:
             write_animation(folder, spec, rng, metrics, reference, outputs, result)
         result.update({
@@ -593,8 +661,7 @@ def write_animated_references(root: str) -> None:
     for count, name in list(MATCHED.items()) + [(FULL_BOUNCES, FULL)]:
         image = reference_image(ANIMATED_SCENE, count)
         write_png(os.path.join(folder, f"{name}.png"), image)
-        with open(os.path.join(folder, f"{name}.exr"), "wb") as f:
-            f.write(EXR_MAGIC)
+        write_reference_exr(os.path.join(folder, f"{name}.exr"), image)
         write_png(os.path.join(folder, f"{name}.indirect.png"), np.clip(image - direct, 0, 1))
     for index in MEASURED_FRAMES:
         image = reference_image(ANIMATED_SCENE, FULL_BOUNCES, index / (ANIMATION_FRAMES - 1))
@@ -613,8 +680,11 @@ def write_references(root: str, sweeps: bool) -> None:
         for count, name in layers.items():
             image = reference_image(scene, count)
             write_png(os.path.join(folder, f"{name}.png"), image)
-            with open(os.path.join(folder, f"{name}.exr"), "wb") as f:
-                f.write(EXR_MAGIC)
+            if sweeps:
+                write_reference_exr(os.path.join(folder, f"{name}.exr"), image)
+            else:
+                with open(os.path.join(folder, f"{name}.exr"), "wb") as f:
+                    f.write(EXR_MAGIC)
             if sweeps:
                 write_png(os.path.join(folder, f"{name}.indirect.png"),
                           np.clip(image - direct, 0, 1))

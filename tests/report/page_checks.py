@@ -453,3 +453,255 @@ def check_strip(checks: Any, scene: str, block: str, measured: dict[str, dict]) 
     checks.check(not problems and bool(run_rows), f"{scene}: the frame strip has the reference "
                  f"row ({max(n_refs)} frames) and one row per run ({len(run_rows)}) with its "
                  "frames in order and its temporal map last", "; ".join(problems[:3]))
+
+
+# ---------------------------------------------------------------------------------------------
+# "The report answers first" (issue: rank order, one badge, error maps on the headline basis,
+# the cross-technique answer first, sweeps apart, noisy timings, devices named)
+# ---------------------------------------------------------------------------------------------
+
+def scene_sections(dom: str) -> dict[str, str]:
+    """scene label -> the markup of its image section."""
+    out = {}
+    for part in re.split(r'(?=<section class="scene" id="scene-)', dom)[1:]:
+        part = part.split("</section>")[0]
+        title = re.search(r"<h3>(.*?) <span", part, re.S)
+        if title:
+            out[html.unescape(title.group(1))] = part
+    return out
+
+
+def ranked_cards(section: str) -> list[tuple[str, int, str]]:
+    """(key, rank, markup) of the ranked cards of a scene section, in page order."""
+    out = []
+    for key, part in cards(section):
+        rank = re.match(r'<div class="card" style="[^"]*" data-key="[^"]+" data-rank="(\d+)"',
+                        part)
+        if rank:
+            out.append((key, int(rank.group(1)), part.split('<div class="card-nums">')[0]))
+    return out
+
+
+def check_rank_order(checks: Any, results_dir: str, dom: str, basis: str) -> None:
+    """Per scene: one ranked card per technique (and reference group on the matched basis), in
+    rank order 1, 2, ... with nondecreasing errors on the basis, and exactly one 'best' badge
+    (one per reference group on the matched basis), on the #1 card, whose run has the lowest
+    error of every ok run of the scene (group)."""
+    runs = results_by_key(results_dir)
+    animated = animated_scenes(runs)
+    problems, badges_seen = [], 0
+    for scene, section in scene_sections(dom).items():
+        own = "sequence" if scene in animated else basis
+        ranked = ranked_cards(section)
+        measured = {k: d for k, d in runs.items() if dig(d, "scene", "label") == scene
+                    and d.get("status") in ("ok", "nonfinite")}
+        if not measured:
+            continue
+
+        def group(key: str) -> str:
+            return dig(runs[key], "reference", "matched") if own == "matched" else ""
+        groups = sorted({group(k) for k in measured}, key=lambda g: (len(g), g))
+        wanted = {(dig(d, "technique", "id"), group(k)) for k, d in measured.items()}
+        shown = [(dig(runs[k], "technique", "id"), group(k)) for k, _, _ in ranked]
+        if sorted(shown) != sorted(wanted):
+            problems.append(f"{scene}: ranked cards {shown} != techniques {sorted(wanted)}")
+        for g in groups:
+            members = [(k, r, m) for k, r, m in ranked if group(k) == g]
+            ranks = [r for _, r, _ in members]
+            values = [basis_value(runs[k], own) for k, _, _ in members]
+            if ranks != list(range(1, len(members) + 1)):
+                problems.append(f"{scene} {g}: ranks {ranks}")
+            if any(v is None for v in values) or values != sorted(values):
+                problems.append(f"{scene} {g}: errors not in rank order {values}")
+            badged = [k for k, _, m in members if 'class="badge b-best' in m]
+            badges_seen += len(badged)
+            best_ok = min((basis_value(d, own), k) for k, d in measured.items()
+                          if d.get("status") == "ok" and group(k) == g)
+            if badged != [best_ok[1]] or members[0][0] != best_ok[1]:
+                problems.append(f"{scene} {g}: badges on {badged}, #1 {members[0][0]}, lowest "
+                                f"ok run {best_ok[1]}")
+    others = [k for k, part in cards(dom) if 'class="badge b-best' in part
+              and 'data-rank="' not in part.split(">")[0]]
+    checks.check(not problems and not others and badges_seen > 0,
+                 f"{basis} basis: the cards of each scene are in rank order (#1, #2, ...: "
+                 "errors nondecreasing), one per technique, and only the overall best run "
+                 f"carries the 'best' badge ({badges_seen} badges)",
+                 "; ".join(problems[:4] + [f"badge off the ranked cards: {others[:2]}"]))
+
+
+def check_order(checks: Any, dom: str) -> None:
+    """The cross-technique answer (equal-time/error tables) right after the header (and the
+    invalid-run warning), before the images; first in the navigation."""
+    body = dom.split("</nav>", 1)[-1]
+    first_h2 = re.search(r'<h2 id="([^"]+)"', body)
+    nav = re.search(r"<nav>(.*?)</nav>", dom, re.S)
+    links = re.findall(r'href="#([^"]+)"', nav.group(1)) if nav else []
+    checks.check(bool(first_h2) and first_h2.group(1) == "equal" and links[:1] == ["equal"]
+                 and dom.find('id="equal"') < dom.find('id="images"'),
+                 "the equal-time/equal-error answer is the first section after the header and "
+                 "the first navigation link", f"first section {first_h2 and first_h2.group(1)}, "
+                 f"nav {links[:3]}")
+
+
+def _png_mean(path: str) -> float:
+    import matplotlib.image  # Debian's python3-matplotlib, like make_fixture
+
+    return float(matplotlib.image.imread(path)[..., :3].mean())
+
+
+def check_error_maps(checks: Any, results_dir: str, dom: str) -> None:
+    """On the full basis, every ranked card shows first the error map against the full
+    reference (the runner's outputs.flip_full_png where recorded, else the report's own map in
+    maps/, labelled as not HDR-FLIP), then the HDR-FLIP map against the bounce-matched
+    reference, labelled. For the `direct` baseline (it lacks every bounce) the first map is
+    brighter than the second."""
+    runs = results_by_key(results_dir)
+    problems, own_maps, runner_maps = [], 0, 0
+    direct_pairs = []
+    for scene, section in scene_sections(dom).items():
+        for key, _, part in ranked_cards(section):
+            data = runs[key]
+            figs = re.findall(r'<figure[^>]*><a href="[^"]*"><img src="([^"]+)"[^>]*class="([^"]*)"'
+                              r'[^>]*></a><figcaption[^>]*>(.*?)</figcaption>', part, re.S)
+            first = next((i for i, f in enumerate(figs) if "errfull" in f[1].split()), None)
+            second = next((i for i, f in enumerate(figs) if "errmatched" in f[1].split()), None)
+            if first is None or second is None or first > second:
+                problems.append(f"{key[:8]}: maps {[(f[0], f[1]) for f in figs]}")
+                continue
+            src, _, caption = figs[first]
+            caption = html.unescape(caption)
+            wanted = dig(data, "outputs", "flip_full_png")
+            if wanted:
+                runner_maps += 1
+                if src != f"runs/{key}/{wanted}" or "HDR-FLIP map vs full reference" not in caption:
+                    problems.append(f"{key[:8]}: runner's map {src} '{caption}'")
+            else:
+                own_maps += 1
+                if not src.startswith("maps/") or "error vs full reference" not in caption \
+                        or "not" not in caption.lower():
+                    problems.append(f"{key[:8]}: own map {src} '{caption}'")
+            msrc, _, mcaption = figs[second]
+            if msrc != f"runs/{key}/flip.png" or "bounce-matched reference" not in \
+                    html.unescape(mcaption):
+                problems.append(f"{key[:8]}: matched map {msrc}")
+            if dig(data, "technique", "id") == "direct" and src.startswith("maps/"):
+                direct_pairs.append((os.path.join(results_dir, src),
+                                     os.path.join(results_dir, msrc)))
+    checks.check(not problems and own_maps > 0 and runner_maps > 0,
+                 f"every ranked card shows the error map against the full reference first "
+                 f"({runner_maps} the runner's HDR-FLIP map, {own_maps} the report's own, labelled "
+                 "as not HDR-FLIP), then the bounce-matched HDR-FLIP map, labelled",
+                 "; ".join(problems[:3]))
+    brighter = [(a, b) for a, b in direct_pairs if _png_mean(a) > 2.0 * _png_mean(b)]
+    checks.check(bool(direct_pairs) and brighter == direct_pairs,
+                 "the direct baseline's first map (vs full reference: it misses every bounce) is "
+                 "much brighter than its bounce-matched map",
+                 str([(round(_png_mean(a), 3), round(_png_mean(b), 3)) for a, b in direct_pairs]))
+
+
+def check_sweeps_apart(checks: Any, results_dir: str, dom: str) -> None:
+    """Runs of one technique form one sweep only if they share their set of swept keys: each
+    sweep figure's caption counts exactly the runs with that set, and its legend names only the
+    other keys of the set, never an empty value (the old bug: 'shared.area_light_samples=')."""
+    runs = results_by_key(results_dir)
+    figures = re.findall(r'<figure class="plot"><a href="figures/(sweep_[^"]+)"><img [^>]*'
+                         r'alt="sweep ([^ "]+) ([^"]+) ([^ "]+)"[^>]*></a><figcaption>(.*?)'
+                         r"</figcaption>", dom, re.S)
+    problems = []
+    for name, tech, scene, key, caption in figures:
+        tech, scene, key = html.unescape(tech), html.unescape(scene), html.unescape(key)
+        keysets = {tuple(sorted(dig(d, "technique", "swept") or {})) for d in runs.values()
+                   if dig(d, "technique", "id") == tech and dig(d, "scene", "label") == scene
+                   and key in (dig(d, "technique", "swept") or {})}
+        if len(keysets) != 1:
+            problems.append(f"{name}: key sets {keysets}")
+            continue
+        keyset = keysets.pop()
+        count = sum(1 for d in runs.values() if dig(d, "technique", "id") == tech
+                    and dig(d, "scene", "label") == scene and d.get("status") in ("ok", "nonfinite")
+                    and tuple(sorted(dig(d, "technique", "swept") or {})) == keyset)
+        if f"({count} runs" not in strip_tags(caption):
+            problems.append(f"{name}: caption '{strip_tags(caption)[:80]}' != {count} runs")
+        legend = [t for t in svg_texts(os.path.join(results_dir, "figures", name)) if "=" in t]
+        bad = [t for t in legend if t.endswith("=") or t.split("=")[0] not in keyset
+               or t.split("=")[0] == key]
+        if bad:
+            problems.append(f"{name}: legend {bad}")
+    direct = [f for f in figures if f[1] == "direct" and f[2] == "cornell_box"]
+    checks.check(not problems and len(direct) == 2
+                 and all("One of 2 separate sweeps" in strip_tags(f[4]) for f in direct),
+                 f"each sweep is drawn on its own ({len(figures)} figures; direct on cornell_box: "
+                 "area-light samples and PCF radius apart, each caption saying so), legends "
+                 "name only the sweep's other keys", "; ".join(problems[:3]))
+
+
+NOISY = 0.10
+
+
+def _noisy(summary: Any) -> bool:
+    median, iqr = dig(summary, "median"), dig(summary, "iqr")
+    return isinstance(median, (int, float)) and isinstance(iqr, (int, float)) and median > 0 \
+        and iqr > NOISY * median
+
+
+def check_noisy(checks: Any, results_dir: str, dom: str) -> None:
+    """Every frame time whose IQR is above 10 % of its median is flagged (class "noisy") in the
+    run table (static and dynamic frame), on the cards, in the error-vs-time figures (SVG id
+    noisy-time-<key>), in the header; and no other one is."""
+    runs = results_by_key(results_dir)
+    animated = animated_scenes(runs)
+    measured = {k: d for k, d in runs.items() if d.get("status") in ("ok", "nonfinite")}
+    static = {k for k, d in runs.items() if _noisy(dig(d, "timing", "frame_gpu_ms"))}
+    dynamic = {k for k, d in runs.items() if _noisy(dig(d, "timing", "dynamic_frame_gpu_ms"))}
+    ranked_by = {k for k in measured if (k in dynamic if dig(measured[k], "scene", "label")
+                                         in animated else k in static)}
+    problems = []
+    rows = dict(re.findall(r'<tr class="run-row[^"]*" data-key="([^"]+)">(.*?)</tr>', dom, re.S))
+    for key, row in rows.items():
+        for col, wanted in (("frame", key in static), ("dynamic_frame", key in dynamic)):
+            cell = re.search(rf'<td class="c-{col} [^"]*"[^>]*>(.*?)</td>', row, re.S)
+            if cell and ('class="noisy"' in cell.group(1)) != wanted:
+                problems.append(f"run table {key[:8]} {col}: marked {not wanted}")
+    for key, part in cards(dom):
+        line = re.search(r'<div class="time">(.*?)</div>', part, re.S)
+        if line and ('class="noisy"' in line.group(1)) != (key in ranked_by):
+            problems.append(f"card {key[:8]}: marked {key not in ranked_by}")
+    fig_dir = os.path.join(results_dir, "figures")
+    marked = set()
+    for name in os.listdir(fig_dir) if os.path.isdir(fig_dir) else []:
+        if name.startswith("pareto_"):
+            with open(os.path.join(fig_dir, name), encoding="utf-8") as f:
+                marked |= set(re.findall(r'id="noisy-time-([0-9a-f]+)"', f.read()))
+    plotted = {k for k in ranked_by if measured[k].get("status") in ("ok", "nonfinite")}
+    if marked != plotted:
+        problems.append(f"error-vs-time figures mark {sorted(marked)}, noisy {sorted(plotted)}")
+    header = re.search(r"<td>noisy timings</td><td>(.*?)</td></tr>", dom, re.S)
+    expected = len({(k, "s") for k in static if k in measured}
+                   | {(k, "d") for k in dynamic if k in measured})
+    if bool(header) != bool(expected) or (header and f"{expected} noisy timing"
+                                           not in strip_tags(header.group(1))):
+        problems.append(f"header: {header and strip_tags(header.group(1))[:80]}, {expected}")
+    if expected and 'id="noisy-timings"' not in dom:
+        problems.append("no definition of noisy timings")
+    checks.check(not problems and (not static or bool(rows)),
+                 f"noisy timings (IQR > 10 % of the median: {len(static)} static, "
+                 f"{len(dynamic)} dynamic frame times) are marked in the run table, the cards, "
+                 "the error-vs-time figures and the header, and no other timing is",
+                 "; ".join(problems[:4]))
+
+
+def check_device_captions(checks: Any, results_dir: str, dom: str) -> None:
+    """Every table comparing techniques (equal time/error, Pareto fronts, the cost tables) has a
+    caption naming the device model (device.name) its times come from; the run table a line."""
+    names = {dig(d, "device", "name") for d in results_by_key(results_dir).values()
+             if dig(d, "device", "name")}
+    tables = re.findall(r'<table class="data (?:ranking|cost)"[^>]*>(.*?)</thead>', dom, re.S)
+    bad = [t[:120] for t in tables
+           if not re.search(r'<caption class="device-line">timed on ([^<]+)</caption>', t)
+           or not any(n in html.unescape(t) for n in names)]
+    line = re.search(r'<p class="device-line">Timed on (.*?)</p>', dom, re.S)
+    checks.check(bool(tables) and not bad and bool(line)
+                 and any(n in html.unescape(line.group(1)) for n in names),
+                 f"every table comparing techniques ({len(tables)}) names the device model "
+                 f"({', '.join(sorted(names))}) in its caption, the run table in a line above it",
+                 str(bad[:2]))

@@ -15,6 +15,7 @@ only if nothing failed, 77 (ctest SKIP_RETURN_CODE) if Chromium is not installed
 """
 from __future__ import annotations
 
+import html
 import html.parser
 import json
 import os
@@ -253,6 +254,12 @@ def check_main(checks: Checks, tmp: str) -> None:
     page_checks.check_ties(checks, dom)
     page_checks.check_overhead(checks, dom, measurable=True)
     page_checks.check_animation(checks, fixture, dom)
+    page_checks.check_rank_order(checks, fixture, dom, "full")
+    page_checks.check_order(checks, dom)
+    page_checks.check_error_maps(checks, fixture, dom)
+    page_checks.check_sweeps_apart(checks, fixture, dom)
+    page_checks.check_noisy(checks, fixture, dom)
+    page_checks.check_device_captions(checks, fixture, dom)
     checks.check("256^3 voxel grid needs 2.0 GiB" in dom, "the unsupported run's reason is shown")
     checks.check("0badc0ffee0badc0" in dom and "unreadable" in dom,
                  "the malformed run folder is listed as unreadable with its path")
@@ -364,6 +371,10 @@ def check_no_sweeps(checks: Checks, tmp: str) -> None:
     page_checks.check_device(checks, fixture, dom, "GPU")
     page_checks.check_overhead(checks, dom, measurable=False)
     page_checks.check_animation(checks, fixture, dom)
+    page_checks.check_rank_order(checks, fixture, dom, "matched")
+    page_checks.check_noisy(checks, fixture, dom)
+    page_checks.check_device_captions(checks, fixture, dom)
+    check_inspector_placeholders(checks, tmp, page)
     checks.check("the full reference image and the reference indirect layers are not recorded"
                  in dom and "/full.png" not in dom,
                  "no-sweep fixture (older runner): no full reference image, and the page says so")
@@ -529,6 +540,183 @@ def check_devices(checks: Checks, tmp: str) -> None:
                      "there are several")
 
 
+# ---------------------------------------------------------------------------------------------
+# The image inspector
+# ---------------------------------------------------------------------------------------------
+
+def selftest(checks: Checks, tmp: str, page: str, what: str, items: list[str]) -> list[dict]:
+    """Loads the page with '#inspector-selftest:<item>;<item>...' (item: 'x,y' or 'x,y:KEY');
+    returns what the inspector saw for each item."""
+    dom = load_dom(checks, tmp, page, what, "#inspector-selftest:" + ";".join(items))
+    found = re.search(r'<pre id="inspector-selftest-result"[^>]*>(.*?)</pre>', dom, re.S)
+    try:
+        records = json.loads(html.unescape(found.group(1))) if found else []
+    except ValueError:
+        records = []
+    checks.check(len(records) == len(items) and not any("error" in r for r in records),
+                 f"{what}: the self-test ran ({len(items)} item(s))",
+                 str([r.get("error") for r in records]) if records else dom[-300:])
+    return records + [{}] * (len(items) - len(records))
+
+
+def f16(values) -> list[float]:
+    import numpy as np  # noqa: E402 (Debian's python3-numpy, like make_fixture)
+
+    return [float(v) for v in np.asarray(values, dtype=np.float64).astype(np.float16)]
+
+
+def parse_numbers(text: str) -> list[float]:
+    return [float(v) for v in re.findall(r"-?\d+(?:\.\d+)?(?:e[-+]?\d+)?", text)]
+
+
+def probe_pixel(run, ref) -> tuple[int, int]:
+    """A pixel where the run differs from the reference and from its right and lower neighbour
+    by more than 5 % (so a value read at the wrong pixel or layer fails the check)."""
+    import numpy as np  # noqa: E402
+
+    h, w = run.shape[:2]
+    for y in range(h // 4, h - 1):
+        for x in range(w // 4, w - 1):
+            here = run[y, x]
+            if not np.all(np.isfinite(here)) or here.min() <= 0.01:
+                continue
+            far = [ref[y, x], run[y, x + 1], run[y + 1, x], ref[y, x + 1]]
+            if all(np.all(np.abs(o - here) > 0.05 * np.abs(here)) for o in far):
+                return x, y
+    raise AssertionError("no discriminating pixel in the fixture")
+
+
+def check_inspector(checks: Checks, tmp: str) -> None:
+    """The inspector, driven in Chromium by the page's self-test (#inspector-selftest:x,y[:key]):
+    it opens on the first run card's first image, the flip keys step through the card's layers
+    in order, the zoom keys set an integer nearest-neighbour factor (3 after '−' x 12 and '+' x
+    2) and the image's width follows it, and the linear values shown at a pixel equal the
+    fixture's EXR values (float16-rounded) of the run and of the full reference, read here with
+    an independent reader (fixture_exr.py); the report's own error map shows |ΔY| / mean Y of
+    those values. On an older runner's folder (placeholder EXRs) it still opens and says why
+    there are no values. Also: the embedded data respects the size limit, its files exist."""
+    import numpy as np  # noqa: E402
+
+    import fixture_exr  # noqa: E402
+
+    fixture = os.path.join(tmp, "fixture-inspector")
+    make_fixture(fixture)
+    result = make_report([fixture])
+    page = os.path.join(fixture, "report.html")
+    checks.check(result.returncode == 0, "inspector fixture: report built", result.stderr[-600:])
+    with open(page, encoding="utf-8") as f:
+        markup = f.read()
+    payload = re.search(r'<script type="application/json" id="gilab-inspector">(.*?)</script>',
+                        markup, re.S)
+    data = json.loads(payload.group(1)) if payload else {"images": {}, "groups": {}}
+    sizes = [(im["w"], im["h"], im["fmt"], len(im["b64"])) for im in data["images"].values()]
+    checks.check(bool(sizes) and all(w * h <= 256 * 256 and n == 4 * -(-(w * h * 3 *
+                 (2 if fmt == "f16" else 4)) // 3) for w, h, fmt, n in sizes)
+                 and "at most 256×256 pixels" in markup,
+                 f"the embedded linear images ({len(sizes)}) are at most 256×256, float16/32 RGB, "
+                 "and the page says so")
+    srcs = {layer["src"] for g in data["groups"].values() for layer in g["layers"]}
+    missing = [s for s in srcs if not os.path.isfile(os.path.join(fixture,
+                                                                  urllib.parse.unquote(s)))]
+    checks.check(bool(srcs) and not missing, f"every inspector layer ({len(srcs)} files) exists",
+                 str(missing[:3]))
+
+    runs = page_checks.results_by_key(fixture)
+    ranked = [k for k, _, _ in page_checks.ranked_cards(markup)]
+    first_key = ranked[0] if ranked else ""
+    data_run = runs.get(first_key, {})
+    run_rgb = fixture_exr.layer_rgb(fixture_exr.read_exr(os.path.join(
+        fixture, "runs", first_key, "output.exr")))
+    full_rgb = fixture_exr.layer_rgb(fixture_exr.read_exr(os.path.normpath(os.path.join(
+        fixture, "runs", first_key, page_checks.dig(data_run, "reference", "full_exr")))))
+    x, y = probe_pixel(run_rgb, full_rgb)
+    # The report's own error map: a `direct` card without the runner's map vs full reference.
+    own = next((k for k in ranked if not page_checks.dig(runs[k], "outputs", "flip_full_png")
+                and page_checks.dig(runs[k], "technique", "id") == "direct"), "")
+    if not checks.check(bool(own), "the fixture has a direct card without a runner's map"):
+        return
+    run2 = fixture_exr.layer_rgb(fixture_exr.read_exr(os.path.join(fixture, "runs", own,
+                                                                    "output.exr")))
+    full2 = fixture_exr.layer_rgb(fixture_exr.read_exr(os.path.normpath(os.path.join(
+        fixture, "runs", own, page_checks.dig(runs[own], "reference", "full_exr")))))
+    x2, y2 = probe_pixel(run2, full2)
+    record, record2 = selftest(checks, tmp, page, "inspector self-test",
+                               [f"{x},{y}", f"{x2},{y2}:{own}"])
+    if not record:
+        return
+    matched = page_checks.dig(data_run, "reference", "matched")
+    has_map = bool(page_checks.dig(data_run, "outputs", "flip_full_png"))
+    layers = ["run", "full reference",
+              "HDR-FLIP vs full reference" if has_map else "error vs full reference",
+              f"HDR-FLIP vs bounce-matched reference ({matched})",
+              f"bounce-matched reference ({matched})"]
+    opened = record.get("opened", {})
+    checks.check(record.get("key") == first_key and opened.get("open") and
+                 opened.get("layer") == "run" and opened.get("layers", [])[:5] == layers
+                 and opened.get("size") == [run_rgb.shape[1], run_rgb.shape[0]],
+                 "inspector: a click on the first card's first image opens it on 'run', with "
+                 "the card's layers in order (run, full reference, its error map, the "
+                 "bounce-matched map and reference, ...) at the EXR's size",
+                 json.dumps(opened)[:300])
+    steps = [(s["key"], s["layer"]) for s in record.get("steps", [])]
+    flips = [("ArrowRight", layers[1]), ("3", layers[2]), (" ", layers[3]),
+             ("ArrowLeft", layers[2]), ("2", layers[1])]
+    checks.check(steps[:5] == flips and steps[-3:] == [("1", "run"), ("3", layers[2]),
+                                                         ("Escape", layers[2])]
+                 and record.get("closed") is True,
+                 "inspector: → / space / ← / digit keys flip between the layers, Esc closes it",
+                 str(steps[:5]))
+    zooms = [s["zoom"] for s in record.get("steps", []) if s["key"] in "+-"]
+    checks.check(record.get("zoom") == 3 and zooms[-3:] == [1, 2, 3]
+                 and abs(record.get("imageWidth", 0) - 3 * run_rgb.shape[1]) < 0.5,
+                 "inspector: − / + step the nearest-neighbour zoom (1× at the bottom, then 2×, "
+                 "3×) and the image is drawn that many pixels per pixel",
+                 f"zoom {record.get('zoom')}, width {record.get('imageWidth')}, {zooms[-3:]}")
+    ref_want, run_want = f16(full_rgb[y, x]), f16(run_rgb[y, x])
+    wrong = f16(run_rgb[y, x + 1])
+    got_ref = parse_numbers(record.get("reference", {}).get("values") or "")
+    got_run = parse_numbers(record.get("run", {}).get("values") or "")
+    shown_ref = parse_numbers(record.get("reference", {}).get("text", "").split("RGB")[-1])
+    shown_run = parse_numbers(record.get("run", {}).get("text", "").split("RGB")[-1])
+    close = lambda a, b, tol: len(a) == len(b) == 3 and all(  # noqa: E731
+        abs(p - q) <= tol * max(abs(q), 1e-6) for p, q in zip(a, b))
+    checks.check(record.get("pixel") == [x, y] and got_ref == ref_want and got_run == run_want
+                 and close(shown_ref, ref_want, 6e-4) and close(shown_run, run_want, 6e-4)
+                 and record["reference"].get("pos") == f"pixel ({x}, {y})",
+                 f"inspector: the linear values under the cursor at pixel ({x}, {y}) are the "
+                 "fixture EXRs' (float16): full reference and run, as numbers and as shown",
+                 f"reference {got_ref} / {shown_ref} vs {ref_want}; run {got_run} / {shown_run} "
+                 f"vs {run_want}")
+    checks.check(not close(got_run, wrong, 1e-3) and not close(got_run, ref_want, 1e-3),
+                 "inspector (negative check): the value at the probe pixel differs from its "
+                 "neighbour's and the reference's, so a wrong pixel or layer would fail")
+
+    # The report's own error map (a run without outputs.flip_full_png): its value at the pixel.
+    record = record2
+    luma = np.array([0.2126, 0.7152, 0.0722])
+    run_y = np.asarray(f16(run2.reshape(-1))).reshape(run2.shape) @ luma
+    ref_y = np.asarray(f16(full2.reshape(-1))).reshape(full2.shape) @ luma
+    want = abs(run_y[y2, x2] - ref_y[y2, x2]) / ref_y[np.isfinite(ref_y)].mean()
+    got = parse_numbers(record.get("error_map", {}).get("values") or "")
+    checks.check(record.get("key") == own and record.get("error_map", {}).get("layer")
+                 == "error vs full reference" and len(got) == 1
+                 and abs(got[0] - want) <= 1e-9 * want and want > 0.05,
+                 f"inspector: the report's own error map shows |ΔY| / mean Y of the linear "
+                 f"values at pixel ({x2}, {y2}) ({want:.4f})", f"got {got}")
+
+
+
+def check_inspector_placeholders(checks: Checks, tmp: str, page: str) -> None:
+    """On an older runner's folder (placeholder EXRs) the inspector opens, flips and says why
+    it has no linear values."""
+    record, = selftest(checks, tmp, page, "inspector self-test, placeholder EXRs", ["5,5"])
+    text = record.get("run", {}).get("text", "") if record else ""
+    checks.check(record.get("closed") is True and record.get("run", {}).get("values") == ""
+                 and "no linear values" in text and "output.exr" in text,
+                 "inspector on an older runner's folder (placeholder EXRs): it opens and flips, "
+                 "and says why there are no linear values", text)
+
+
 HOSTILE_RUNS = {
     "minimal": {"status": "ok"},
     "wrong_types": {"status": "ok", "key": 5, "index": "x", "scene": 5, "technique": {
@@ -609,7 +797,7 @@ def main(argv: list[str]) -> int:
     # Chains in parallel threads (Chromium mostly waits): the merge needs the main fixture,
     # check_devices the flat one.
     chains = [[check_main, check_merge], [check_no_sweeps, check_devices],
-              [check_detection, check_hostile, check_edges]]
+              [check_detection, check_hostile, check_edges, check_inspector]]
     results: dict[str, Checks] = {}
 
     def run_chain(steps: list) -> None:
