@@ -14,11 +14,11 @@
  * Every voxel outside the voxels that hold the scene's bounds is made solid (and the grid's
  * border layer), so the empty space is closed at the scene's box: a scene open to the sky is
  * lidded at its top, instead of keeping the cube grid's whole empty remainder, which wrapped the
- * scene and thinned into one clump node holding most of the skeleton (Sponza: 205,321 voxels,
- * 64 % of the VPLs). A solid standing free in the empty space (not touching the box or anything
- * that does) still gets a closed surface of skeleton around it: the setup warns when one node
- * holds more than 1 % of the skeleton.
- * Positions and radii are converted to world units here.
+ * scene and thinned into one clump node holding most of the skeleton (Sponza, as issue 30's review
+ * measured it: 205,321 voxels, 64 % of the VPLs). A solid standing free in the empty space (not
+ * touching the box or anything that does) still gets a closed surface of skeleton around it: the
+ * setup warns when one node holds more than 1 % of the skeleton. Positions and radii are converted
+ * to world units here.
  */
 #include <cstdint>
 #include <functional>
