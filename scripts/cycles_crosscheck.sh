@@ -11,7 +11,7 @@
 #   a      = n * (relMSE - noise(y)),  noise(y) from y's own full_stderr layer
 # hence the spp (a / 1e-3) and seconds (spp x s/spp) each renderer needs for relMSE 1e-3, and
 # the agreement of the two renderers: mean ratio and relMSE beyond the expected noise.
-# Writes OUT/crosscheck.{json,md}; the result figures belong in the README.
+# Writes OUT/crosscheck.{json,md}; the result figures belong in docs/reference.md ("Measured").
 #
 # usage: scripts/cycles_crosscheck.sh [--resolution N] [--gilab-spp LIST] [--cycles-spp LIST]
 #          [--long-spp L] [--threads T] [--out DIR] [--scene-gltf PATH] [--cycles-roulette on|off]

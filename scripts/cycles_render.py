@@ -5,7 +5,7 @@
 # read from the glTF JSON itself; gilab's camera (a scene description's "camera", in glTF
 # Y-up coordinates); rays through pixel centres, no adaptive sampling, denoising or clamping;
 # black world. Writes a linear 32-bit float RGB OpenEXR and, beside it, a JSON with the render
-# time. The figures the cross-check derives from it belong in the README.
+# time. The figures the cross-check derives from it belong in docs/reference.md ("Measured").
 #
 #   blender -b --factory-startup -t T --python scripts/cycles_render.py -- \
 #       --scene DIR/scene.json --out DIR/cycles_16.exr --resolution 256 --samples 16 \

@@ -206,7 +206,7 @@ TEST_F(GpuCvgi, NeighbourTestKeepsWallsLitAtAnAngle) {
 // Issue 28: the paper's Gaussian gives non-lit neighbours weight 0 and renormalises, so a dark
 // face takes its lit neighbours' mean, also through a wall; gaussian_visibility (ours, default)
 // skips neighbours behind occupied voxels. Two rooms, door closed, seen from the dark room: the
-// path tracer has 0 there (README: the shared direct light is 0 too).
+// path tracer has 0 there (docs/shared_passes.md, "Measured": the shared direct light is 0 too).
 TEST_F(GpuCvgi, GaussianDoesNotSpreadLightThroughAClosedWall) {
     Scene scene = loadSceneFile(
         std::string(GILAB_SOURCE_DIR) + "/scenes/stress/two_rooms_door.json", "room_b_closed");

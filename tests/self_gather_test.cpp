@@ -92,8 +92,8 @@ TEST_F(GpuSelfGather, LitFloorGathersNoLightFromItself) {
 }
 
 TEST_F(GpuSelfGather, OctreeWithTheDenseLiftGathersALittle) {
-    // The octree's extra lift (docs/vct_svo.md "Lift"): with the dense clearance (octree_lift_extra
-    // 0) the floor's own cells reach the lifted samples' footprint.
+    // The octree's extra lift (docs/techniques/vct_svo.md "Lift"): with the dense clearance
+    // (octree_lift_extra 0) the floor's own cells reach the lifted samples' footprint.
     const FloorGather g = floorGather(
         *m_ctx, "vct",
         {{"voxel_resolution", "64"}, {"storage", "octree"}, {"octree_lift_extra", "0"}});

@@ -1,5 +1,5 @@
-// `vct` light injection (docs/vct.md, "Light injection"): per-photon irradiance averaged per
-// voxel and light is exact for planes at any orientation; emitter samples are injected through
+// `vct` light injection (docs/techniques/vct.md, "Light injection"): per-photon irradiance averaged
+// per voxel and light is exact for planes at any orientation; emitter samples are injected through
 // hemicube light-view maps carrying the area light's flux; auto map sizes follow the footprint
 // rule and stay inside the storage-buffer limit. Small grids (32^3, 64^3), 64^2 images.
 #include <algorithm>

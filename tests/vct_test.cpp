@@ -1,5 +1,6 @@
 // `vct` (Crassin et al. 2011): light injection energy, parameter validation and the rendered
-// indirect layer on the Cornell box spot variant (docs/vct.md). Small: 32^3 grids, 64^2 images.
+// indirect layer on the Cornell box spot variant (docs/techniques/vct.md). Small: 32^3 grids, 64^2
+// images.
 #include <cmath>
 #include <memory>
 #include <string>

@@ -1,4 +1,4 @@
-// The audit's table: audit.json (every number), audit.md (README) and audit.html (report).
+// The audit's table: audit.json (every number), audit.md (docs/audit.md) and audit.html (report).
 #include <cstdio>
 
 #include "experiments/audit/audit.h"

@@ -41,9 +41,19 @@ const Image& ReferenceSet::stdError(ref::Layer layer) const {
     return m_stdError[size_t(layer)].image;
 }
 
+const metrics::NoiseFloorSamples& ReferenceSet::noiseFloor(
+    const std::string& basis, const Image& image, const metrics::MetricOptions& options) const {
+    const std::string key = basis + (options.resampleFlip ? "|flip" : "");
+    auto it = m_noiseFloors.find(key);
+    if (it == m_noiseFloors.end())
+        it = m_noiseFloors.emplace(key, metrics::computeNoiseFloor(image, options)).first;
+    return it->second;
+}
+
 MatchedReference ReferenceSet::match(int bounces) const {
     using ref::Layer;
     MatchedReference m;
+    m.set = this;
     m.full = mean(Layer::Full);
     m.fullStdError = stdError(Layer::Full);
     // All indirect light = bounce1 + bounce2 + bounce3plus.

@@ -10,10 +10,12 @@
  * they come from the same paths, so this is an approximation; for "all" the full layer's own
  * standard error is used, which is exact).
  */
+#include <map>
 #include <string>
 #include <vector>
 
 #include "core/image/image.h"
+#include "experiments/metrics/metrics.h"
 #include "reference/cache.h"
 
 namespace gilab::exp {
@@ -27,6 +29,7 @@ struct MatchedReference {
     Image fullIndirect;  // all indirect light of the reference (regions, "vs full" metrics)
     Image full;
     Image fullStdError;
+    const class ReferenceSet* set = nullptr;  // the set it came from (shared noise floors)
 };
 
 class ReferenceSet {
@@ -35,6 +38,15 @@ public:
     const ref::ReferenceResult& result() const { return m_result; }
     /** `bounces` as TechniqueInfo::indirectBounces (kAllBounces = all). */
     MatchedReference match(int bounces) const;
+    /**
+     * metrics::computeNoiseFloor(image, options), computed on first use and reused by every
+     * run compared with this reference: the reference-only half of the error bars, the same
+     * numbers at a fraction of the cost (docs/metrics.md, "Cost"). `basis` names the image (one
+     * of this set's matched images) and whatever of `options` differs between callers; the
+     * rest (tone map, ppd, resamples, seed) is one experiment's and must not change.
+     */
+    const metrics::NoiseFloorSamples& noiseFloor(const std::string& basis, const Image& image,
+                                                 const metrics::MetricOptions& options) const;
 
 private:
     const Image& mean(ref::Layer layer) const;
@@ -42,6 +54,7 @@ private:
     ref::ReferenceResult m_result;
     std::vector<ImageLayer> m_mean;
     std::vector<ImageLayer> m_stdError;
+    mutable std::map<std::string, metrics::NoiseFloorSamples> m_noiseFloors;
 };
 
 }  // namespace gilab::exp

@@ -43,22 +43,31 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
     options.tonemap = tonemap;
     options.ppd = spec.ppd;
 
+    // Each basis' noise floor once per reference, shared by every run (the same numbers).
+    const auto shareFloor = [&](const std::string& basis, const Image& image) {
+        options.noiseFloor =
+            reference.set ? &reference.set->noiseFloor(basis, image, options) : nullptr;
+    };
     nlohmann::ordered_json out;
     metrics::MetricMaps maps;
     options.referenceStdError = &reference.finalStdError;
+    shareFloor("final:" + reference.name, reference.final);
     out["final"] = metrics::toJson(metrics::computeMetrics(final, reference.final, options, &maps));
     metrics::writeMagmaPng((outDir / "flip.png").string(), maps.flip);
 
-    // Against all the light, whatever the technique claims: how far from full GI it is.
+    // Against all the light, whatever the technique claims: how far from full GI it is. The
+    // study's basis, so its HDR-FLIP gets its error bar too (ties in docs/report.md).
     options.referenceStdError = &reference.fullStdError;
-    options.resampleFlip = false;
-    metrics::MetricMaps fullMaps;  // the report's headline basis (issue 31): its map first
+    shareFloor("full", reference.full);
+    metrics::MetricMaps fullMaps;  // the report's headline basis: its map first
     out["final_vs_full"] =
         metrics::toJson(metrics::computeMetrics(final, reference.full, options, &fullMaps));
     metrics::writeMagmaPng((outDir / "flip_full.png").string(), fullMaps.flip);
+    options.resampleFlip = false;  // the layers below: PSNR, SSIM and relMSE bars only
 
     if (bounces != 0 && !reference.indirect.empty()) {
         options.referenceStdError = &reference.indirectStdError;
+        shareFloor("indirect:" + reference.name, reference.indirect);
         out["indirect"] =
             metrics::toJson(metrics::computeMetrics(indirect, reference.indirect, options));
     }
@@ -71,6 +80,7 @@ nlohmann::ordered_json computeRunMetrics(const std::vector<ImageLayer>& layers,
         nlohmann::ordered_json regions;
         for (const RegionSpec& r : spec.regions) {
             metrics::MetricOptions ro = options;
+            ro.noiseFloor = nullptr;  // a region's floor pools its own pixels
             ro.mask = regionMask(r, reference);
             ro.referenceStdError = &reference.finalStdError;
             nlohmann::ordered_json entry;

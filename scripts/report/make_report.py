@@ -19,10 +19,13 @@ import glob
 import os
 import platform
 import sys
+from typing import Optional
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 
 import report_figures  # noqa: E402
+import report_study  # noqa: E402
+from report_study_html import series_colors, study_figure  # noqa: E402
 from report_analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,  # noqa: E402
                              best_runs, by_device, by_scene, find_sweeps, has_one_bounce,
                              pareto_fronts, pareto_ties, pass_colors, scene_basis, slug,
@@ -124,6 +127,54 @@ def write_figures(results: Results, colors: dict[str, str], fig_dir: str) -> Fig
     return figures
 
 
+def audit_path(dirs: list[str]) -> Optional[str]:
+    """results/audit/audit.json next to the (first) results folder, when it exists."""
+    path = os.path.join(os.path.dirname(os.path.abspath(dirs[0])), "audit", "audit.json")
+    return path if os.path.isfile(path) else None
+
+
+def make_study(results: Results, dirs: list[str]) -> list[report_study.Study]:
+    """The cross-technique study (report_study.py) of each device model's runs on which two or
+    more techniques were measured on one scene (times of two models are never compared)."""
+    runs = results.runs
+    rows = report_study.rows_from_runs(runs)
+    if not report_study.is_study(rows):
+        return []
+    report_study.add_leak_shares(rows, runs)
+    audit = report_study.load_audit(audit_path(dirs))
+    return [report_study.analyse(group, audit=audit)
+            for group in report_study.by_device(rows).values() if report_study.is_study(group)]
+
+
+def write_study_figures(studies: list[report_study.Study], results: Results,
+                        colors: dict[str, str], fig_dir: str) -> dict[str, str]:
+    """figures/study_<scene>[_<device>].svg for every scene with two or more measured series
+    (keys 'scene' or 'scene on device' when several devices)."""
+    out: dict[str, str] = {}
+    if not studies:
+        return out
+    os.makedirs(fig_dir, exist_ok=True)
+    report_figures.configure()
+    scenes = by_scene(results.runs)
+    for i, study in enumerate(studies):
+        scolors = series_colors(study.series, colors)
+        keys = {r.get("key") for r in study.rows}
+        for scene, st in study.scenes.items():
+            if len({p.series for p in st.points if p.ranked}) < 2:
+                continue
+            name = f"study_{slug(scene)}" + (f"_{i + 1}" if i else "")
+            path = os.path.join(fig_dir, f"{name}.svg")
+            runs = [r for r in scenes.get(scene, []) if r.measured and r.frame_ms is not None
+                    and r.key in keys]
+            study_figure(st, scolors, path, report_figures.axis_time_label(runs, "frame time"))
+            out[study_key(study, scene, len(studies))] = path
+    return out
+
+
+def study_key(study: report_study.Study, scene: str, count: int) -> str:
+    return scene if count < 2 else f"{scene} on {study.device}"
+
+
 def page_fronts(runs: list[Run], basis: Basis) -> tuple[dict, dict]:
     """A scene's Pareto fronts and ties (Page.fronts, Page.ties) by comparable group, of each
     device model apart when its runs were timed on several (keys '<group> on <device>')."""
@@ -148,6 +199,9 @@ def build_report(dirs: list[str], out_dir: str) -> str:
     os.makedirs(out_dir, exist_ok=True)
     colors = technique_colors([r.technique for r in results.runs])
     figures = write_figures(results, colors, os.path.join(out_dir, "figures"))
+    studies = make_study(results, dirs)
+    figures.study = write_study_figures(studies, results, colors,
+                                        os.path.join(out_dir, "figures"))
     clear_old_maps(out_dir)
     scenes = by_scene(results.runs)
     bases = {scene: scene_basis(rs) for scene, rs in scenes.items()}
@@ -158,7 +212,7 @@ def build_report(dirs: list[str], out_dir: str) -> str:
                 docs_dir=REPO_DOCS if os.path.isdir(REPO_DOCS) else None,
                 generated=datetime.datetime.now(datetime.timezone.utc)
                 .strftime("%Y-%m-%dT%H:%M:%SZ"),
-                tool_versions=tool_versions(), inspector=Inspector(out_dir))
+                tool_versions=tool_versions(), inspector=Inspector(out_dir), study=studies)
     path = os.path.join(out_dir, "report.html")
     tmp = path + f".tmp-{os.getpid()}"
     with open(tmp, "w", encoding="utf-8") as f:

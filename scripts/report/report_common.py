@@ -29,6 +29,7 @@ class Figures:
     no_effect: list[tuple[Sweep, str]] = field(default_factory=list)  # sweep, why (no figure)
     sequence: dict[str, str] = field(default_factory=dict)  # animated scene -> per-frame error
     temporal: dict[str, str] = field(default_factory=dict)  # animated scene -> instability bars
+    study: dict[str, str] = field(default_factory=dict)  # scene -> cross-technique study figure
 
 
 @dataclass
@@ -46,6 +47,8 @@ class Page:
     generated: str
     tool_versions: str
     inspector: Optional[Inspector] = None  # the image inspector's data (report_inspect)
+    study: list = field(default_factory=list)  # report_study.Study per device model (2+
+    # techniques measured on a scene; empty otherwise)
 
     def basis(self, scene: str) -> Basis:
         return self.bases.get(scene) or MATCHED

@@ -705,8 +705,9 @@ def passes_html(page: Page) -> str:
 # The page
 # ---------------------------------------------------------------------------------------------
 
-NAV_TITLES = (("equal", "Equal time/error"), ("images", "Images"), ("animation", "Animation"),
-              ("runs", "All runs"), ("pareto", "Error vs. time"), ("sweeps", "Sweeps"),
+NAV_TITLES = (("study", "Study"), ("equal", "Equal time/error"), ("images", "Images"),
+              ("animation", "Animation"), ("runs", "All runs"), ("pareto", "Error vs. time"),
+              ("sweeps", "Sweeps"),
               ("passes", "Time per pass"), ("skipped", "Skipped passes"),
               ("unreadable", "Unreadable"), ("definitions", "Definitions"))
 
@@ -737,8 +738,31 @@ def inspector_html(page: Page) -> str:
             '<pre id="inspector-selftest-result" hidden></pre>')
 
 
+def study_html(page: Page) -> str:
+    """The cross-technique study section (report_study_html), one block per device model;
+    '' when it does not apply."""
+    from report_study_html import series_colors, study_section_html
+
+    blocks = []
+    for study in page.study:
+        keys = {r.get("key") for r in study.rows}
+        measured = [r for r in page.results.runs if r.measured and r.frame_ms is not None
+                    and r.key in keys]
+        count = len(page.study)
+        figures = {scene: page.figures.study[k] for scene in study.scenes
+                   for k in [scene if count < 2 else f"{scene} on {study.device}"]
+                   if k in page.figures.study}
+        block = study_section_html(study, series_colors(study.series, page.colors), figures,
+                                   lambda p: rel_url(p, page.out_dir),
+                                   device_label(measured or page.results.runs),
+                                   first=not blocks)
+        if block:
+            blocks.append(block)
+    return "".join(blocks)
+
+
 def render_page(page: Page) -> str:
-    sections = [invalid_banner_html(page), equal_html(page), scenes_html(page),
+    sections = [invalid_banner_html(page), study_html(page), equal_html(page), scenes_html(page),
                 animation_html(page), run_table_html(page) + failures_html(page),
                 pareto_html(page), sweeps_html(page), passes_html(page), skipped_html(page),
                 unreadable_html(page)]

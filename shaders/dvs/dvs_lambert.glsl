@@ -1,5 +1,5 @@
 // Per-voxel diffuse terms of deferred voxel shading (notes 003 §2.4), shared by voxel_direct.comp
-// and the tests' hand-checked values (docs/dvs.md).
+// and the tests' hand-checked values (docs/techniques/dvs.md).
 #ifndef GILAB_DVS_LAMBERT_GLSL
 #define GILAB_DVS_LAMBERT_GLSL
 

@@ -77,7 +77,7 @@ void main() {
         float dist;
         vec3 ePerp = lightIrradiancePerp(light, p, wi, dist);
         uint type = uint(light.positionType.w);
-        // Emitter samples are points on the emitter: floor r at one voxel (docs/dvs.md).
+        // Emitter samples are points on the emitter: floor r at one voxel (docs/techniques/dvs.md).
         if (type == PASS_LIGHT_EMITTER_SAMPLE && dist < pc.params.y)
             ePerp *= (dist * dist) / (pc.params.y * pc.params.y);
         if (all(equal(ePerp, vec3(0.0)))) continue;

@@ -4,7 +4,7 @@
 //   base.a = a.
 // The paper stores incoming radiance and shades toward each cone at trace time (§7); voxels are
 // Lambertian here, so storing the outgoing radiance gives the same diffuse result and drops only
-// glossy secondary bounces (docs/vct.md).
+// glossy secondary bounces (docs/techniques/vct.md).
 #include "vct/inject_common.glsl"
 
 layout(local_size_x = 4, local_size_y = 4, local_size_z = 4) in;
@@ -25,6 +25,7 @@ void main() {
     vec4 albedoOpacity = texelFetch(voxelAlbedoOpacity, c, 0);
     float a = clamp(albedoOpacity.a, 0.0, 1.0);
     vec3 radiance = a * albedoOpacity.rgb * (1.0 / 3.14159265358979) * max(irradiance, vec3(0.0));
-    // RGBA16F saturates at 65504: clamp there rather than store Inf (counted in docs/vct.md)
+    // RGBA16F saturates at 65504: clamp there rather than store Inf (counted in
+    // docs/techniques/vct.md)
     imageStore(radianceBase, c, vec4(min(radiance, vec3(65504.0)), a));
 }

@@ -1,7 +1,7 @@
 // A photon's footprint on its surface's tangent plane, cut into cells for the injection deposits
-// (docs/vct.md "Light injection"; shared by the dense splat and the octree splat). The footprint
-// is the parallelogram spanned by edges ex, ey (world) around the hit; it is cut into kx x ky
-// cells of at most v0 / 2 per side, very long (grazing) footprints clipped at kMaxCellsPerEdge
+// (docs/techniques/vct.md "Light injection"; shared by the dense splat and the octree splat). The
+// footprint is the parallelogram spanned by edges ex, ey (world) around the hit; it is cut into kx
+// x ky cells of at most v0 / 2 per side, very long (grazing) footprints clipped at kMaxCellsPerEdge
 // cells per edge and kMaxCells in all. `radius` is a cell's half-diagonal, clamped to
 // [0.1, 0.5] v0: a deposit reaches every voxel the plane crosses within it.
 #ifndef GILAB_VCT_PHOTON_FOOTPRINT_GLSL

@@ -1,6 +1,6 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Anisotropic radiance filter one level up (Crassin §9, notes 001 §2.8; docs/vct_svo.md
+// Anisotropic radiance filter one level up (Crassin §9, notes 001 §2.8; docs/techniques/vct_svo.md
 // "Anisotropic"): writes the six directional bricks (slot + f, f = -X,+X,-Y,+Y,-Z,+Z) of every
 // node of depth d. Children are the leaves' isotropic bricks (d + 1 = D) or the children's
 // bricks of the same face.

@@ -1,7 +1,7 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Octree injection, step 1 (docs/vct_svo.md "Injection"): the photon range of every light, so
-// that the splat can run once per light (count pass, then E / count pass) with indirect
+// Octree injection, step 1 (docs/techniques/vct_svo.md "Injection"): the photon range of every
+// light, so that the splat can run once per light (count pass, then E / count pass) with indirect
 // dispatches. pc.args: x photons, y lights, z pass, w groups per row (maxComputeWorkGroupCount).
 //   pass 0, one thread per photon i of light l = irradiance.w: atomicMax of i + 1 into word END
 //     and of (photons - i) into word FIRST (svoLights cleared to 0 before), so a light's photons

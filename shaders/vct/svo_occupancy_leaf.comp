@@ -1,7 +1,8 @@
 #version 460
 #extension GL_GOOGLE_include_directive : require
-// Octree build, step 1 (docs/vct_svo.md): a leaf cell n is occupied when one of the 27 voxels of
-// its vertex-centred brick (voxel centres 2n .. 2n+2 per axis) is covered (albedoOpacity.a).
+// Octree build, step 1 (docs/techniques/vct_svo.md): a leaf cell n is occupied when one of the 27
+// voxels of its vertex-centred brick (voxel centres 2n .. 2n+2 per axis) is covered
+// (albedoOpacity.a).
 #include "vct/svo_common.glsl"
 
 layout(set = 1, binding = 0) uniform sampler3D voxelAlbedoOpacity;

@@ -1,7 +1,7 @@
-// voxelConeSample for the sparse voxel octree (techniques/vct/svo.h, docs/vct_svo.md; Crassin
-// §5, §9, notes 001 §2.8-2.9): quadrilinear lookup = trilinear inside the vertex-centred brick of
-// the node whose level matches the lod (hardware linear filter on the brick pool: the brick's
-// samples are texel centres, so a position inside the node never leaves its brick), linear
+// voxelConeSample for the sparse voxel octree (techniques/vct/svo.h, docs/techniques/vct_svo.md;
+// Crassin §5, §9, notes 001 §2.8-2.9): quadrilinear lookup = trilinear inside the vertex-centred
+// brick of the node whose level matches the lod (hardware linear filter on the brick pool: the
+// brick's samples are texel centres, so a position inside the node never leaves its brick), linear
 // between the levels floor(lod) and floor(lod) + 1. Descends from the root each time; stops at a
 // collapsed node (empty space -> vec4(0)). Level 0 (leaves) is isotropic. Levels >= 1 of an
 // anisotropic octree: per axis the directional brick chosen by the sign of `dir` (dir.x < 0 ->

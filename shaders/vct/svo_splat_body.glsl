@@ -1,4 +1,4 @@
-// Photon splat into the octree's leaves (Crassin §8.2, notes 001 §2.5; docs/vct_svo.md
+// Photon splat into the octree's leaves (Crassin §8.2, notes 001 §2.5; docs/techniques/vct_svo.md
 // "Injection"): the dense path's rule (vct/splat_dense_body.glsl) on the leaf lattice. Launched
 // once per light l = pc.args.x with an indirect dispatch over the light's photon range
 // (svo_light_ranges.comp), in two modes (pc.args.z):

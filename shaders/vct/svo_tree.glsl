@@ -1,5 +1,5 @@
 // Sparse voxel octree layout shared by the build / inject passes and the cone sampler
-// (techniques/vct/svo.h, docs/vct_svo.md; Crassin et al. 2011 §4.1, notes 001 §2.1).
+// (techniques/vct/svo.h, docs/techniques/vct_svo.md; Crassin et al. 2011 §4.1, notes 001 §2.1).
 // The includer includes vct/svo_info.glsl, declares its blocks and defines SVO_NODE(i) (a uint
 // of the node pool) and SVO_INFO (an SvoInfo) before including this file.
 // Node i = 12 words: child (index of the first node of its 2x2x2 tile, 0 = none), brick

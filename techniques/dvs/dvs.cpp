@@ -32,7 +32,8 @@ TechniqueInfo DvsTechnique::describe() {
     info.bouncesParam = "bounces";
     info.checkParams = [](const ParamSet& p) { (void)dvsSettingsFrom(p); };
     // Emitters light the voxels through the shared emitter samples (direct light at the voxel,
-    // the source of the first bounce); their raw emission is never gathered (docs/dvs.md).
+    // the source of the first bounce); their raw emission is never gathered
+    // (docs/techniques/dvs.md).
     info.supports.emissiveSurfaces = true;
     return info;
 }

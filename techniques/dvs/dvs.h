@@ -1,7 +1,8 @@
 #pragma once
 /**
  * `dvs`: deferred voxel shading, J. Villegas, "Deferred Voxel Shading for Real-Time Global
- * Illumination" (CLEI 2016; the VCTRenderer write-up). Extraction: notes 003; docs/dvs.md.
+ * Illumination" (CLEI 2016; the VCTRenderer write-up). Extraction: notes 003;
+ * docs/techniques/dvs.md.
  *
  * Set-up (ctx.submitTimed):
  *   voxelize, voxel_resolve  shared Voxelizer (albedo, normal, emission volumes)
@@ -17,8 +18,8 @@
  * Per frame: "trace" (P1) over the shared G-buffer: diffuse cones (E14), specular cone,
  * AO (debug view "ao"), optional cone shadows for the direct layer (E13).
  *
- * Deviations (docs/dvs.md): HDR RGBA16F radiance, physically consistent 1/pi and no GI strength,
- * our light falloff (lights.glsl), voxel centres, emitters lit through the shared emitter
+ * Deviations (docs/techniques/dvs.md): HDR RGBA16F radiance, physically consistent 1/pi and no GI
+ * strength, our light falloff (lights.glsl), voxel centres, emitters lit through the shared emitter
  * samples (their direct light on the voxels) and never gathered as raw emission.
  * Parameters: techniques/dvs/dvs_settings.cpp.
  */

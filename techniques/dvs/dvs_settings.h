@@ -2,7 +2,7 @@
 /**
  * Parameters of `dvs` (deferred voxel shading, Villegas; notes 003) and their parsed form.
  * The spec table (dvsParamSpecs) drives help, validation and sweeps; DvsSettings is what the
- * passes read. Every source value is listed in docs/dvs.md next to our default.
+ * passes read. Every source value is listed in docs/techniques/dvs.md next to our default.
  */
 #include <cstdint>
 #include <string>
@@ -56,7 +56,8 @@ float dvsSpecularApertureDeg(float roughness);
 inline constexpr uint32_t kDvsBounceConeCount = 4;
 float dvsBounceApertureDeg();
 
-/** The light-sample distance floor of L1 in voxels (emitter samples near a voxel, docs/dvs.md). */
+/** The light-sample distance floor of L1 in voxels (emitter samples near a voxel,
+ *  docs/techniques/dvs.md). */
 inline constexpr float kDvsEmitterMinDistanceVoxels = 1.0f;
 
 }  // namespace gilab

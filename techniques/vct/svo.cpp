@@ -52,9 +52,9 @@ glm::uvec3 poolBricks(uint32_t bricks, uint32_t maxDim) {
 }
 
 /**
- * Conservative CPU occupancy of the leaf cells (docs/vct_svo.md "pool sizing"): every voxel
- * whose box, grown by a quarter voxel, meets a triangle's bounding box and plane marks the leaf
- * cells whose bricks hold that voxel centre (cells v/2, and v/2 - 1 for even v). It contains
+ * Conservative CPU occupancy of the leaf cells (docs/techniques/vct_svo.md "pool sizing"): every
+ * voxel whose box, grown by a quarter voxel, meets a triangle's bounding box and plane marks the
+ * leaf cells whose bricks hold that voxel centre (cells v/2, and v/2 - 1 for even v). It contains
  * the voxelizer's coverage (exact triangle/box overlap), so the GPU build never needs more.
  */
 std::vector<uint8_t> cpuLeafOccupancy(const Scene& scene, const VoxelGrid& grid) {
@@ -431,8 +431,9 @@ void SparseVoxelOctree::inject(TechniqueContext& ctx, VkCommandBuffer cmd,
         m_photonSet.writeBuffer(0, *photons.buffer);
     }
     {
-        // docs/vct_svo.md "Injection": each light's photon range, then per light the deposit
-        // counts and the mean irradiance (E / count per deposit) into the canonical leaf copies.
+        // docs/techniques/vct_svo.md "Injection": each light's photon range, then per light the
+        // deposit counts and the mean irradiance (E / count per deposit) into the canonical leaf
+        // copies.
         PassScope pass(ctx, cmd, "svo_inject");
         vkCmdFillBuffer(cmd, m_accum.handle(), 0, VK_WHOLE_SIZE, 0);
         vkCmdFillBuffer(cmd, m_lights.handle(), 0, VK_WHOLE_SIZE, 0);

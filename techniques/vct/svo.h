@@ -1,22 +1,23 @@
 #pragma once
 /**
  * Sparse voxel octree storage of `vct` (Crassin et al. 2011 §4, notes 001 §2.1-2.3, §2.6-2.7,
- * docs/vct_svo.md). Node pool of 2x2x2 tiles (one child-tile pointer per node, brick pointer,
- * +-x/y/z neighbour pointers, parent pointer); brick pool of vertex-centred 3x3x3 bricks (opacity
- * + premultiplied radiance, alpha-premultiplied albedo). Leaf bricks sample the voxelizer's N^3
- * volumes at voxel centres (spacing v0); level l bricks have spacing v0 2^l and are filtered with
- * the 3^3 Gaussian. Empty nodes are collapsed (no children, no brick).
+ * docs/techniques/vct_svo.md). Node pool of 2x2x2 tiles (one child-tile pointer per node, brick
+ * pointer, +-x/y/z neighbour pointers, parent pointer); brick pool of vertex-centred 3x3x3 bricks
+ * (opacity + premultiplied radiance, alpha-premultiplied albedo). Leaf bricks sample the
+ * voxelizer's N^3 volumes at voxel centres (spacing v0); level l bricks have spacing v0 2^l and are
+ * filtered with the 3^3 Gaussian. Empty nodes are collapsed (no children, no brick).
  *
  * Anisotropic (Crassin §9, default in vct): non-leaf nodes store six directional radiance bricks
  * (-X,+X,-Y,+Y,-Z,+Z, rays travelling toward that direction) built by front-to-back pair
  * compositing inside the 3^3 Gaussian; leaves stay isotropic. The radiance pool is indexed by a
  * per-node radiance slot (1 brick, or 6 consecutive bricks for directional nodes); the geometry
- * pool and the flux accumulators by the node's brick index (docs/vct_svo.md "Anisotropic").
+ * pool and the flux accumulators by the node's brick index (docs/techniques/vct_svo.md
+ * "Anisotropic").
  *
- * Injection as the dense path (docs/vct_svo.md "Injection"): per light, the photons' irradiance
- * is averaged over the deposits of their footprints in every leaf sample (count pass, then E /
- * count pass), summed over lights; leaf radiance = a albedo / pi E. Facing (Crassin §7): leaves
- * keep the voxelizer's mean normal in a normal brick pool; leaf samples and the first
+ * Injection as the dense path (docs/techniques/vct_svo.md "Injection"): per light, the photons'
+ * irradiance is averaged over the deposits of their footprints in every leaf sample (count pass,
+ * then E / count pass), summed over lights; leaf radiance = a albedo / pi E. Facing (Crassin §7):
+ * leaves keep the voxelizer's mean normal in a normal brick pool; leaf samples and the first
  * directional level are weighted by common/voxel_facing.glsl.
  *
  * Pools are sized in the constructor from a conservative CPU bound of the occupied leaf cells
@@ -56,9 +57,9 @@ static_assert(sizeof(GpuSvoInfo) == 320);
 
 class SparseVoxelOctree {
 public:
-    /** Directional filter of an anisotropic octree (docs/vct_svo.md "Anisotropic"): Pairs = the
-     *  dense rule (front-to-back pairs) on the two pair halves of the 3^3 tent; Slab = one
-     *  front-to-back step through the tent's footprint (half-depth end samples). */
+    /** Directional filter of an anisotropic octree (docs/techniques/vct_svo.md "Anisotropic"):
+     *  Pairs = the dense rule (front-to-back pairs) on the two pair halves of the 3^3 tent; Slab =
+     *  one front-to-back step through the tent's footprint (half-depth end samples). */
     enum class DirectionalFilter : uint32_t { Pairs = 1, Slab = 2 };
     /** `anisotropic`: six directional radiance bricks per non-leaf node (Crassin §9).
      *  `floatAtomics = false` forces the 32-bit fixed-point accumulators (tests). */

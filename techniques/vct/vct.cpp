@@ -106,7 +106,7 @@ TechniqueInfo VctTechnique::describe() {
         enumParam("octree_filter", "slab", {"pairs", "slab"},
                   "octree directional bricks: pairs = the dense rule (front-to-back child pairs "
                   "in the Gaussian, Crassin §9); slab = front to back through the parent's whole "
-                  "footprint (walls on odd samples stay opaque; docs/vct_svo.md)",
+                  "footprint (walls on odd samples stay opaque; docs/techniques/vct_svo.md)",
                   rebuild),
         boolParam("anisotropic", true,
                   "6 directional mip volumes (dense) or directional bricks above the leaves "
@@ -122,9 +122,9 @@ TechniqueInfo VctTechnique::describe() {
                    "full apex angle of each diffuse cone"),
         floatParam("diffuse_tilt_deg", 60.0, 0.0, 89.0, "deg",
                    "angle of the ring cones from the normal"),
-        floatParam(
-            "step_factor", 0.5, 0.05, 2.0, "",
-            "cone step d' = step_factor x cone diameter (the paper does not fix it; docs/vct.md)"),
+        floatParam("step_factor", 0.5, 0.05, 2.0, "",
+                   "cone step d' = step_factor x cone diameter (the paper does not fix it; "
+                   "docs/techniques/vct.md)"),
         floatParam("max_distance", 1.0, 0.01, 2.0, "grid sides",
                    "maximum cone length in units of the voxel grid's side"),
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
@@ -139,7 +139,7 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("octree_lift_extra", 0.25, 0.0, 1.0, "cells",
                    "added to lift with storage = octree (vertex-centred samples reach further "
                    "than cells): 0.5 = worst-case clearance (no self-gather, +24-38 % energy "
-                   "over dense), 0.25 = matches dense; docs/vct_svo.md \"Lift\""),
+                   "over dense), 0.25 = matches dense; docs/techniques/vct_svo.md \"Lift\""),
         enumParam("lift_rule", "cell", {"cell", "blend"},
                   "cell: clear the coarser blended level's cell 2^ceil(L) (exact, no self-gather); "
                   "blend: the two cell sizes mixed by the level weight (continuous in t)"),
@@ -367,7 +367,7 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
     g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
                             p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
     // The octree's vertex-centred samples carry a surface's data further than cell-centred
-    // voxels do (docs/vct_svo.md "Lift"): its clearance adds octree_lift_extra cells.
+    // voxels do (docs/techniques/vct_svo.md "Lift"): its clearance adds octree_lift_extra cells.
     const float lift = p.getFloat("lift");
     const float octreeExtra = p.getFloat("octree_lift_extra");
     g.misc =

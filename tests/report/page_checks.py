@@ -530,17 +530,19 @@ def check_rank_order(checks: Any, results_dir: str, dom: str, basis: str) -> Non
 
 
 def check_order(checks: Any, dom: str) -> None:
-    """The cross-technique answer (equal-time/error tables) right after the header (and the
-    invalid-run warning), before the images; first in the navigation."""
+    """The cross-technique answer right after the header (and the invalid-run warning), before
+    the images, and first in the navigation: the study section (two or more techniques on a
+    scene, report_study_html.py) when present, then the equal-time/error tables."""
     body = dom.split("</nav>", 1)[-1]
-    first_h2 = re.search(r'<h2 id="([^"]+)"', body)
+    h2s = re.findall(r'<h2 id="([^"]+)"', body)
     nav = re.search(r"<nav>(.*?)</nav>", dom, re.S)
     links = re.findall(r'href="#([^"]+)"', nav.group(1)) if nav else []
-    checks.check(bool(first_h2) and first_h2.group(1) == "equal" and links[:1] == ["equal"]
+    first = ["study", "equal"] if "study" in h2s else ["equal"]
+    checks.check(h2s[:len(first)] == first and links[:len(first)] == first
                  and dom.find('id="equal"') < dom.find('id="images"'),
-                 "the equal-time/equal-error answer is the first section after the header and "
-                 "the first navigation link", f"first section {first_h2 and first_h2.group(1)}, "
-                 f"nav {links[:3]}")
+                 "the cross-technique answer (study section where it applies, then the "
+                 "equal-time/equal-error tables) comes first after the header and first in the "
+                 "navigation", f"first sections {h2s[:2]}, nav {links[:3]}")
 
 
 def _png_mean(path: str) -> float:

@@ -1,0 +1,252 @@
+#!/usr/bin/python3
+"""Writes the study's findings (docs/findings.md) from a results folder.
+
+    /usr/bin/python3 scripts/findings.py results/study [--audit results/audit/audit.json]
+        [--out docs/findings.md] [--glance docs/findings_glance.md]
+        [--budgets 50,200,1000] [--fractions 0.9,0.75,0.6,0.45]
+
+Reads runs/<key>/result.json like the report (scripts/report/report_data.py), analyses them with
+scripts/report/report_study.py (series, Pareto fronts, equal-time and equal-error tables with
+ties, the direct floor, where each series breaks) and writes: the Markdown file, one PNG per
+scene (<out dir>/findings/<scene>.png, 600x400 px: HDR-FLIP and indirect relMSE against frame
+time, the Pareto front), and the at-a-glance table (--glance, default findings_glance.md next to
+--out). Sentences only restate numbers of the tables. Unfinished, unsupported and failed runs are
+counted and listed, never fatal. Rules and thresholds: docs/report.md, "Cross-technique study".
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import json
+import os
+import statistics
+import subprocess
+import sys
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+sys.path.insert(0, os.path.join(HERE, "report"))
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("agg")
+import report_study as S  # noqa: E402
+from report_analysis import slug  # noqa: E402
+from report_study_html import md_breaks, md_table, series_colors, study_figure  # noqa: E402
+
+PNG_SIZE = (6.0, 4.0)  # inches at PNG_DPI: 600 x 400 px
+PNG_DPI = 100
+
+
+def parse_args(argv: list[str]) -> argparse.Namespace:
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("results", help="results folder of the study (results/study)")
+    p.add_argument("--audit", help="audit.json of `gilab audit` (default: "
+                   "<results>/../audit/audit.json when it exists)")
+    p.add_argument("--out", default=os.path.join(HERE, "..", "docs", "findings.md"),
+                   help="the Markdown file (default docs/findings.md)")
+    p.add_argument("--glance", help="the at-a-glance table (default findings_glance.md next "
+                   "to --out)")
+    p.add_argument("--budgets", default=",".join(f"{b:g}" for b in S.BUDGETS_MS),
+                   help="equal-time budgets, ms, comma-separated")
+    p.add_argument("--fractions", default=",".join(f"{f:g}" for f in S.ERROR_FRACTIONS),
+                   help="equal-error targets as fractions of the direct floor")
+    return p.parse_args(argv)
+
+
+def git_commit() -> str:
+    """HEAD of the repository holding this script, '-dirty' when tracked files changed."""
+    repo = os.path.dirname(HERE)
+    try:
+        head = subprocess.run(["git", "-C", repo, "rev-parse", "HEAD"], capture_output=True,
+                              text=True, timeout=20).stdout.strip()
+        dirty = subprocess.run(["git", "-C", repo, "status", "--porcelain",
+                                "--untracked-files=no"], capture_output=True, text=True,
+                               timeout=20).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return (head or "unknown") + ("-dirty" if head and dirty else "")
+
+
+def experiment_info(results: str) -> dict:
+    try:
+        with open(os.path.join(results, "experiment.json"), encoding="utf-8") as f:
+            data = json.load(f)
+        return data if isinstance(data, dict) else {}
+    except (OSError, ValueError):
+        return {}
+
+
+def _fmt_list(values: list[float]) -> str:
+    return ", ".join(f"{v:g}" for v in values) or "—"
+
+
+def ladders_md(study: "S.Study") -> list[str]:
+    """Each series' rungs, cheapest first (median frame time over the static scenes), the
+    paper's marked: what the curves are made of."""
+    md = ["## The ladders", "",
+          "Each series' settings, cheapest first by the median static frame time over the scenes "
+          "it ran on; ◆ = the paper's settings (`report_study.PAPER_RUNGS`). Why these knobs and "
+          "values: docs/experiments.md, \"The study\".", "",
+          "| series | rungs (median frame time) |", "|---|---|"]
+    for s in study.series:
+        times: dict[str, list[float]] = {}
+        paper: dict[str, bool] = {}
+        for st in study.scenes.values():
+            if st.animated:
+                continue
+            for p in st.series.get(s, []):
+                if p.ranked:
+                    times.setdefault(p.rung, []).append(p.x)
+                    paper[p.rung] = paper.get(p.rung, False) or bool(p.paper)
+        if not times:
+            continue
+        rungs = sorted(times, key=lambda r: statistics.median(times[r]))
+        md.append(f"| {s} | " + "; ".join(
+            f"{'◆ ' if paper[r] else ''}{r or 'defaults'} ({S.ms(statistics.median(times[r]))})"
+            for r in rungs) + " |")
+    return md + [""]
+
+
+def write_findings(results: str, out: str, glance_path: str, audit: str | None,
+                   budgets: tuple[float, ...], fractions: tuple[float, ...],
+                   argv: list[str]) -> tuple[str, str, list[str]]:
+    all_rows = S.load_rows([results])
+    groups = list(S.by_device(all_rows).items())  # the device model with the most runs first
+    rows = groups[0][1] if groups else []
+    others = [f"{len(g)} runs on {name}" for name, g in groups[1:]]
+    study = S.analyse(rows, budgets, fractions, S.load_audit(audit))
+    out_dir = os.path.dirname(os.path.abspath(out))
+    fig_dir = os.path.join(out_dir, "findings")
+    os.makedirs(fig_dir, exist_ok=True)
+    colors = series_colors(study.series)
+    info = experiment_info(results)
+    total = info.get("runs_total")
+    date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
+    command = "/usr/bin/python3 scripts/findings.py " + " ".join(argv)
+    md = ["# Findings of the cross-technique study", "",
+          f"- commit `{git_commit()}` (the runs: {', '.join(study.commits) or 'unknown'})",
+          f"- device: {study.device}; machine: {study.machine}",
+          f"- date: {date}",
+          f"- regenerate: `{command}` (the runs: `build/gilab run "
+          "experiments/configs/study.json`)",
+          f"- runs: {len(all_rows)} finished"
+          + (f" of {total} planned ({total - len(all_rows)} not finished)"
+             if isinstance(total, int) else "")
+          + " — " + ", ".join(f"{n} {s}" for s, n in sorted(study.statuses.items()))
+          + (f"; not compared (another device model): {'; '.join(others)}" if others else ""),
+          "- rules (ties, targets, leaks): docs/report.md, \"Cross-technique study\"; "
+          f"budgets {_fmt_list(list(budgets))} ms; equal-error targets "
+          f"{_fmt_list(list(fractions))} × the direct floor.", ""]
+    if not all_rows:
+        md += ["No finished runs yet.", ""]
+    md += ladders_md(study)
+    md += ["## Reference noise and the direct floor", "",
+           "Direct floor: the `direct` run's HDR-FLIP vs the full reference (all indirect light "
+           "missing). Direct light's own error: `metrics.direct` (`direct.*` columns), the "
+           "emission+direct layer against the reference's emission+direct, shared by every "
+           "technique.", "",
+           "Noise floors: what an image that differs from the reference by the reference's own "
+           "noise would score (relMSE, HDR-FLIP); the HDR-FLIP error bar is the spread of a "
+           "run's HDR-FLIP over resampled references (median over the scene's runs).", "",
+           "| scene | reference spp | relMSE noise floor | HDR-FLIP noise floor | HDR-FLIP error "
+           "bar | direct floor HDR-FLIP (time) | direct light HDR-FLIP | direct light energy | "
+           "shadow leak |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for scene, st in study.scenes.items():
+        f = st.direct_floor
+        md.append(f"| {scene} | {_fmt_list(st.reference_spp)} | {S.sig3(st.rel_mse_noise_floor)}"
+                  f" | {S.sig3(st.flip_floor) if st.flip_floor is not None else 'not recorded'}"
+                  f" | {S.sig3(st.flip_noise) if st.flip_noise is not None else 'not recorded'}"
+                  f" | {S.sig3(f.y) + ' (' + S.ms(f.x) + ')' if f else '—'}"
+                  f" | {S.sig3(st.direct_light_flip)} | {S.sig3(st.direct_light_energy)} | "
+                  + (f"{S.sig3(100 * st.direct_light_leak)} %"
+                     if st.direct_light_leak is not None else "—") + " |")
+    md.append("")
+    pngs = []
+    for scene, st in study.scenes.items():
+        md += [f"## {scene}", ""]
+        if any(p.ranked for p in st.points):
+            path = os.path.join(fig_dir, f"{slug(scene)}.png")
+            where = "lavapipe (CPU)" if "lavapipe" in st.device else st.device
+            study_figure(st, colors, path, f"frame time, {where}, ms",
+                         size=PNG_SIZE, dpi=PNG_DPI)
+            pngs.append(path)
+            md += [f"![{scene}: error against frame time]"
+                   f"({os.path.relpath(path, out_dir)})", ""]
+        missing = [p for p in st.points if not p.ranked]
+        if missing:
+            md += ["Not ranked: " + "; ".join(
+                " ".join(x for x in (p.series, p.rung, f"({p.status})") if x)
+                for p in missing) + ".", ""]
+        series = [s for s in study.series if s in st.series]
+        md += [f"Timed on {st.device}, {study.machine}.", "",
+               "Equal time: best HDR-FLIP vs full reference (frame time) within each budget; "
+               "bold = best, (tie) = within the error bars of the best.", "",
+               md_table(st.equal_time, series, lambda p: f"{S.sig3(p.y)} ({S.ms(p.x)})"),
+               "Equal error: least frame time (HDR-FLIP) to reach each target; (tie) = within "
+               "the timing IQRs of the best.", "",
+               md_table(st.equal_error, series, lambda p: f"{S.ms(p.x)} ({S.sig3(p.y)})"),
+               "Pareto front: " + (", ".join(f"{p.series} {p.rung} ({S.sig3(p.y)}, {S.ms(p.x)})"
+                                             .replace("  ", " ") for p in st.front) or "—"), ""]
+    md += ["## Where it breaks", "", f"Timed on {study.device}, {study.machine}.", "",
+           md_breaks(study), "## Findings", "",
+           "Each sentence restates numbers of the tables above.", ""]
+    md += [f"- {s}" for s in S.findings(study)] or ["- (no findings: no ranked runs yet)"]
+    md.append("")
+    os.makedirs(out_dir, exist_ok=True)
+    with open(out, "w", encoding="utf-8") as f:
+        f.write("\n".join(md))
+    glance = ["| technique | lowest HDR-FLIP vs full reference (scene, frame time) | error left "
+              "vs direct (median) | wins (scene: budgets, ms) | breaks |", "|---|---|---|---|---|"]
+    for g in S.glance(study):
+        best = g["best"]
+        where = ""
+        if best and best[2] != g["technique"]:
+            where = ", " + best[2].partition(" (")[2].rstrip(")")
+        wins = "; ".join(f"{sc}: {'/'.join(b)}" for sc, b in g["wins"].items())
+        glance.append(f"| {g['technique']} | "
+                      + (f"{S.sig3(best[1].y)} ({best[0]}, {S.ms(best[1].x)}{where})"
+                         if best else "—")
+                      + f" | {S.sig3(g['floor_ratio']) if g['floor_ratio'] is not None else '—'}"
+                      + f" | {wins or '—'} | {', '.join(g['breaks']) or '—'} |")
+    glance.append("")
+    glance.append(f"Timed on {study.device}, {study.machine}; commit `{git_commit()}`, {date}; "
+                  f"from {os.path.basename(out)} (`{command}`).")
+    with open(glance_path, "w", encoding="utf-8") as f:
+        f.write("\n".join(glance) + "\n")
+    return out, glance_path, pngs
+
+
+def main(argv: list[str]) -> int:
+    args = parse_args(argv)
+    if not os.path.isdir(args.results):
+        print(f"findings: results folder '{args.results}' does not exist", file=sys.stderr)
+        return 2
+    try:
+        budgets = tuple(float(x) for x in args.budgets.split(",") if x.strip())
+        fractions = tuple(float(x) for x in args.fractions.split(",") if x.strip())
+    except ValueError:
+        print("findings: --budgets and --fractions take comma-separated numbers", file=sys.stderr)
+        return 2
+    audit = args.audit
+    if audit is None:
+        default = os.path.join(os.path.dirname(os.path.abspath(args.results)), "audit",
+                               "audit.json")
+        audit = default if os.path.isfile(default) else None
+    glance = args.glance or os.path.join(os.path.dirname(os.path.abspath(args.out)),
+                                         "findings_glance.md")
+    out, glance, pngs = write_findings(args.results, args.out, glance, audit, budgets,
+                                       fractions, argv)
+    print(out)
+    print(glance)
+    for p in pngs:
+        print(p)
+    with open(out, encoding="utf-8") as f:
+        text = f.read()
+    print(text.split("## Findings", 1)[-1].strip())
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

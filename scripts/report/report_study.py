@@ -1,0 +1,935 @@
+"""Cross-technique analysis of a study (several techniques, each along its quality ladder, on the
+same scenes): series, Pareto fronts, equal-time and equal-error tables, the direct floor, and
+where each series breaks. Pure functions of the result rows; the report (report_study_html.py)
+and scripts/findings.py render what this module computes. Every rule and threshold is defined
+here once and documented in docs/report.md ("Cross-technique study").
+
+A **row** is one run as the runner's results.csv / results.jsonl row (experiments/runner/
+run_store.cpp `resultRow`, the same column names): `scene`, `technique`, `status`, `swept`
+(space-separated swept keys), `param.<key>`, `frame_gpu_ms_median`, `full.flip`, ... Values may be
+numbers or strings (a csv row) or missing/None; nothing here raises on a bad value.
+`row_from_result` makes such a row from a result.json (plus `host`, `cpu`, `direct.energy_ratio`,
+`direct.shadow_leak`, which the csv does not have).
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import statistics
+from dataclasses import dataclass, field
+from typing import Any, Iterable, Optional
+
+# ------------------------------------------------------------------------------------------------
+# Rules and thresholds (docs/report.md, "Cross-technique study")
+# ------------------------------------------------------------------------------------------------
+BUDGETS_MS = (50.0, 200.0, 1000.0)  # equal-time budgets (frame time <= budget)
+# Equal-error targets: these fractions of the scene's direct floor (the `direct` run's HDR-FLIP
+# vs the full reference: the error of leaving out all indirect light).
+ERROR_FRACTIONS = (0.9, 0.75, 0.6, 0.45)
+BASELINE = "direct"
+LEAK_CLOSED, LEAK_OPEN = "rooms_closed", "rooms_open"  # door closed / open, same camera
+LEAK_RATIO = 2.0  # energy_ratio(closed) / energy_ratio(open) above this: a leak
+LEAK_FLIP = 0.01  # HDR-FLIP vs the closed scene's (black) full reference above this: a leak
+LEAK_SHARE = 0.01  # indirect light seen with the door closed / the open reference's: a leak
+ENERGY_BAND = (0.5, 2.0)  # energy ratio outside: flagged (the audit's amber band, docs/audit.md)
+# Temporal instability against the bounce-matched frames (flicker and lag of the light the
+# technique claims; vs the full frames the missing bounces' change would dominate): flagged
+# above this x the lowest instability of any GI series on the same scene. Every GI series
+# measures several x the reference noise floor on the study's sequences (the error pattern
+# moves with the light), so an absolute floor rule would flag them all.
+TEMPORAL_FACTOR = 1.5
+# Scenes that test a failure, not quality: the door-closed rooms' reference is black, so an
+# error there is a leak; they are left out of the findings' winners and the glance table.
+NOT_QUALITY = (LEAK_CLOSED,)
+THIN_WALL_CASES = ("thin_wall", "light_through_wall")  # audit cases shown (name prefixes)
+# The paper's settings of each technique, as rung values of its ladder. A row is a paper rung
+# when every listed parameter has the listed value. vct: Table 1's 3 cones at 256^3, the
+# largest grid lavapipe holds (the paper's 512^3 octree does not fit, docs/techniques/vct.md);
+# dvs: the source repository's 256^3 and 6 cones; cvgi: 128^3 and 128 rays per face (its
+# Tables 1-4); ssvp: Table I's N1 = 256, C = 8, N2 = 256; topovpl: Table I's 1024 VPLs, 256^3.
+PAPER_RUNGS: dict[str, dict[str, object]] = {  # by technique
+    "vct": {"voxel_resolution": 256, "diffuse_cones": 3},
+    "dvs": {"voxel_resolution": 256, "diffuse_cones": 6, "bounces": 1},
+    "cvgi": {"gather": "paper", "voxel_resolution": 128, "rays_per_face": 128},
+    "ssvp": {"first_bounce_vpls": 256, "clusters": 8, "second_bounce_vpls": 256},
+    "topovpl": {"voxel_resolution": 256, "vpls": 1024},
+}
+# Our choices (not the paper's) and the paper's alternative: findings ask whether a winner
+# changes when only the paper's variant is allowed.
+# (technique, our settings, the paper's as printed): experiments/configs/study.json runs both.
+OUR_CHOICES: list[tuple[str, dict[str, object], dict[str, object]]] = [
+    ("cvgi", {"gather": "ray_weighted"}, {"gather": "paper"}),
+    ("vct", {"lift": 1.5}, {"lift": 0}),
+    ("ssvp", {"weights": "physical"}, {"weights": "paper"}),
+    ("topovpl", {"cluster_merge": "visible", "gate_placement": "bottleneck", "gate_radius": "neck"},
+     {"cluster_merge": "none", "gate_placement": "midpoint", "gate_radius": "min"}),
+]
+
+
+def _same_value(a: object, b: object) -> bool:
+    """Parameter values as the rows spell them: '1.5' == 1.5, '0.0' == 0, 'paper' == 'paper'."""
+    try:
+        return float(str(a)) == float(str(b))
+    except ValueError:
+        return str(a) == str(b)
+
+
+def series_params(series: str) -> tuple[str, dict[str, str]]:
+    """'vct (lift=0.0)' -> ('vct', {'lift': '0.0'})."""
+    tech, _, rest = series.partition(" (")
+    parts = [p.split("=", 1) for p in rest.rstrip(")").split(", ") if "=" in p]
+    return tech, {k: v for k, v in parts}
+
+
+def our_choice_pairs(series: Iterable[str]) -> list[tuple[str, str]]:
+    """(our series, the paper's series) of each OUR_CHOICES entry that the study ran both of."""
+    def find(tech: str, want: dict[str, object]) -> Optional[str]:
+        for s in series:
+            t, ps = series_params(s)
+            if t == tech and all(k in ps and _same_value(ps[k], v) for k, v in want.items()):
+                return s
+        return None
+    out = []
+    for tech, ours, paper in OUR_CHOICES:
+        a, b = find(tech, ours), find(tech, paper)
+        if a and b:
+            out.append((a, b))
+    return out
+
+
+def fnum(value: Any) -> Optional[float]:
+    """A finite float from a number or a numeric string, else None."""
+    if isinstance(value, bool) or value is None:
+        return None
+    if isinstance(value, str):
+        try:
+            value = float(value)
+        except ValueError:
+            return None
+    if not isinstance(value, (int, float)):
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def fstr(value: Any) -> str:
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, float) and value.is_integer():
+        return str(int(value))
+    return str(value)
+
+
+def sig3(x: Optional[float], digits: int = 3) -> str:
+    """3 significant digits ('—' for None); no exponent between 1e-3 and 1e5."""
+    if x is None:
+        return "—"
+    if x == 0:
+        return "0"
+    x = float(f"{x:.{digits}g}")  # rounded first: 0.99983 is 1.00, not 1.000
+    if 1e-3 <= abs(x) < 1e5:
+        decimals = max(0, digits - 1 - int(math.floor(math.log10(abs(x)))))
+        return f"{x:.{decimals}f}"
+    return f"{x:.{digits - 1}e}"
+
+
+def ms(x: Optional[float]) -> str:
+    return "—" if x is None else f"{sig3(x)} ms"
+
+
+# ------------------------------------------------------------------------------------------------
+# Rows
+# ------------------------------------------------------------------------------------------------
+def _at(data: Any, *path: str) -> Any:
+    for step in path:
+        if not isinstance(data, dict):
+            return None
+        data = data.get(step)
+    return data
+
+
+def _metric_columns(row: dict, prefix: str, m: Any) -> None:
+    if not isinstance(m, dict):
+        return
+    row[f"{prefix}.flip"] = _at(m, "flip", "mean")
+    row[f"{prefix}.flip_noise"] = _at(m, "error_bars", "flip", "spread")
+    # The HDR-FLIP of the reference's own noise (an exact image would score this).
+    row[f"{prefix}.flip_floor"] = _at(m, "error_bars", "flip", "floor_mean")
+    row[f"{prefix}.rel_mse"] = m.get("rel_mse")
+    row[f"{prefix}.rel_mse_noise_floor"] = _at(m, "error_bars", "rel_mse_noise_floor")
+
+
+def row_from_result(data: dict) -> dict:
+    """The runner's row (run_store.cpp resultRow, the columns this module reads) of a
+    result.json, plus host, cpu and the direct light's energy ratio and shadow leak."""
+    d = data if isinstance(data, dict) else {}
+    params = _at(d, "technique", "params")
+    swept = _at(d, "technique", "swept")
+    row: dict = {
+        "key": d.get("key"), "scene": _at(d, "scene", "label"),
+        "technique": _at(d, "technique", "id"), "status": d.get("status"),
+        "bounces": _at(d, "technique", "indirect_bounces"),
+        "reason": d.get("reason"), "swept": " ".join(swept) if isinstance(swept, dict) else "",
+        "setup_ms": _at(d, "timing", "setup_ms", "total"),
+        "topology_cache_hit": _at(d, "stats", "topology_cache_hit"),
+        "frame_gpu_ms_median": _at(d, "timing", "frame_gpu_ms", "median"),
+        "frame_gpu_ms_iqr": _at(d, "timing", "frame_gpu_ms", "iqr"),
+        "frame_cpu_ms_median": _at(d, "timing", "frame_cpu_ms", "median"),
+        "frame_cpu_ms_iqr": _at(d, "timing", "frame_cpu_ms", "iqr"),
+        "reference_samples": _at(d, "reference", "samples"),
+        "reference_matched": _at(d, "reference", "matched"),
+        "energy_ratio": _at(d, "metrics", "energy_ratio"),
+        "direct.energy_ratio": _at(d, "metrics", "direct", "energy_ratio"),
+        "direct.shadow_leak": _at(d, "metrics", "direct", "shadow_leak"),
+        "device": _at(d, "device", "name"), "device_type": _at(d, "device", "type"),
+        "host": d.get("host") or _at(d, "provenance", "host"),
+        "cpu": _at(d, "provenance", "cpu"),
+        "hardware_threads": _at(d, "provenance", "hardware_threads"),
+        "git_commit": _at(d, "provenance", "git_commit"), "date": _at(d, "provenance", "date"),
+    }
+    for key, value in (params.items() if isinstance(params, dict) else []):
+        row[f"param.{key}"] = value
+    for prefix, path in (("full", "final_vs_full"), ("matched", "final"),
+                         ("indirect", "indirect"), ("direct", "direct")):
+        _metric_columns(row, prefix, _at(d, "metrics", path))
+    nonfinite = d.get("nonfinite")
+    if isinstance(nonfinite, dict):
+        row["nan_pixels"] = sum(fnum(_at(c, "nan_pixels")) or 0 for c in nonfinite.values())
+        row["inf_pixels"] = sum(fnum(_at(c, "inf_pixels")) or 0 for c in nonfinite.values())
+    if isinstance(d.get("animation"), dict):
+        row["animation_frames"] = _at(d, "animation", "frames")
+        row["update_kind"] = _at(d, "animation", "update")
+        row["dynamic_frame_gpu_ms_median"] = _at(d, "timing", "dynamic_frame_gpu_ms", "median")
+        row["dynamic_frame_gpu_ms_iqr"] = _at(d, "timing", "dynamic_frame_gpu_ms", "iqr")
+        row["dynamic_frame_cpu_ms_median"] = _at(d, "timing", "dynamic_frame_cpu_ms", "median")
+        seq = _at(d, "metrics", "sequence")
+        row["sequence.full.flip_mean"] = _at(seq, "full_flip_mean")
+        row["sequence.temporal.instability"] = _at(seq, "temporal", "temporal_instability")
+        row["sequence.temporal.noise_floor"] = _at(seq, "temporal", "noise_floor")
+        row["sequence.temporal_matched.instability"] = _at(seq, "temporal_matched",
+                                                           "temporal_instability")
+        row["sequence.temporal_matched.noise_floor"] = _at(seq, "temporal_matched",
+                                                           "noise_floor")
+    return row
+
+
+def rows_from_runs(runs: Iterable[Any]) -> list[dict]:
+    """Rows of report_data Run records (their result.json in run.data)."""
+    out = []
+    for run in runs:
+        row = row_from_result(getattr(run, "data", {}) or {})
+        row["status"] = getattr(run, "status", row.get("status"))
+        row["_folder"] = getattr(run, "folder", None)
+        out.append(row)
+    return out
+
+
+LEAK_MAX_PIXELS = 262144  # EXRs read for the leak share (larger ones are left unread)
+
+
+def _luminance_sum(path: Optional[str], layer: str) -> Optional[float]:
+    """Σ Rec. 709 luminance of an EXR's '<layer>.R/G/B' (layer '' : R, G, B), finite pixels."""
+    if not path or not os.path.isfile(path):
+        return None
+    from report_exr import ExrImage, read_exr
+
+    prefix = f"{layer}." if layer else ""
+    image = read_exr(path, LEAK_MAX_PIXELS, {prefix + c for c in "RGB"})
+    if not isinstance(image, ExrImage) or not all(prefix + c in image.channels for c in "RGB"):
+        return None
+    r, g, b = (image.channels[prefix + c] for c in "RGB")
+    total = 0.0
+    for y in (0.2126 * x + 0.7152 * yy + 0.0722 * z for x, yy, z in zip(r, g, b)):
+        if math.isfinite(y):
+            total += y
+    return total
+
+
+def add_leak_shares(rows: list[dict], runs: Iterable[Any]) -> None:
+    """Sets `leak.share` on the door-closed scene's rows: Σ luminance of the run's indirect
+    layer (outputs.exr) over Σ luminance of the door-open reference's indirect light (full.exr
+    minus emission+direct.exr); same camera and resolution. Left unset when a file is missing
+    or unreadable."""
+    runs = list(runs)
+    open_ref = None
+    for run in runs:
+        if getattr(run, "scene", None) == LEAK_OPEN and hasattr(run, "reference_path"):
+            full = _luminance_sum(run.reference_path("full_exr"), "")
+            base = run.reference_path("full_exr")
+            direct = _luminance_sum(os.path.join(os.path.dirname(base), "emission+direct.exr")
+                                    if base else None, "")
+            if full is not None and direct is not None and full - direct > 0:
+                open_ref = full - direct
+                break
+    if open_ref is None:
+        return
+    for row, run in zip(rows, runs):
+        if row.get("scene") == LEAK_CLOSED and row.get("status") in ("ok", "nonfinite"):
+            seen = _luminance_sum(run.output_path("exr"), "indirect")
+            if seen is not None:
+                row["leak.share"] = seen / open_ref
+
+
+def load_rows(dirs: list[str]) -> list[dict]:
+    """Every committed run of the folders (report_data's reader: shards merged, in-progress
+    folders ignored) as rows; unreadable run folders are left out."""
+    from report_data import load_results
+
+    runs = load_results(dirs).runs
+    rows = rows_from_runs(runs)
+    add_leak_shares(rows, runs)
+    return rows
+
+
+# ------------------------------------------------------------------------------------------------
+# Series and points
+# ------------------------------------------------------------------------------------------------
+# Parameters that never change the image (caches, diagnostics): runs that differ only in them
+# belong to one series (topovpl's topology_cache = off times the cold set-up, docs/report.md).
+NOT_SERIES_KEYS = {"topology_cache", "same_cluster_stat"}
+
+
+def cached_setup(row: dict) -> bool:
+    """The set-up loaded a cached precomputation (topovpl's topology) instead of building it."""
+    return fnum(row.get("topology_cache_hit")) == 1.0
+
+
+def ladder_keys(rows: list[dict]) -> dict[str, set[str]]:
+    """technique -> the union of its runs' swept keys (its ladder's knobs)."""
+    out: dict[str, set[str]] = {}
+    for r in rows:
+        keys = fstr(r.get("swept")).split()
+        out.setdefault(fstr(r.get("technique")), set()).update(keys)
+    return out
+
+
+def _params(row: dict) -> dict[str, str]:
+    return {k[len("param."):]: fstr(v) for k, v in row.items()
+            if k.startswith("param.") and v is not None and fstr(v) != ""}
+
+
+def series_keys(rows: list[dict]) -> dict[str, list[str]]:
+    """technique -> the parameters that tell its blocks apart: not on its ladder and with more
+    than one value among its runs of one scene (e.g. cvgi's `gather`)."""
+    ladders = ladder_keys(rows)
+    values: dict[tuple[str, str, str], set[str]] = {}
+    for r in rows:
+        tech = fstr(r.get("technique"))
+        for k, v in _params(r).items():
+            if k not in ladders.get(tech, set()) and k not in NOT_SERIES_KEYS:
+                values.setdefault((tech, fstr(r.get("scene")), k), set()).add(v)
+    out: dict[str, set[str]] = {}
+    for (tech, _, k), vs in values.items():
+        if len(vs) > 1:
+            out.setdefault(tech, set()).add(k)
+    return {t: sorted(ks) for t, ks in out.items()}
+
+
+def series_name(row: dict, keys: dict[str, list[str]]) -> str:
+    tech = fstr(row.get("technique")) or "?"
+    ps = _params(row)
+    parts = [f"{k}={ps[k]}" for k in keys.get(tech, []) if k in ps]
+    return f"{tech} ({', '.join(parts)})" if parts else tech
+
+
+def rung_text(row: dict, ladders: dict[str, set[str]]) -> str:
+    """The run's ladder values, 'voxel_resolution=128 diffuse_cones=3' ('' without a ladder)."""
+    ps = _params(row)
+    return " ".join(f"{k}={ps[k]}" for k in sorted(ladders.get(fstr(row.get("technique")), ()))
+                    if k in ps)
+
+
+def is_paper_rung(row: dict, series: str) -> Optional[bool]:
+    """Whether the run is at the paper's settings (None: no paper rung defined)."""
+    rung = PAPER_RUNGS.get(series.partition(" (")[0])
+    if rung is None:
+        return None
+    ps = _params(row)
+    return all(fstr(ps.get(k)) == fstr(v) for k, v in rung.items())
+
+
+def animated_scene(rows: list[dict]) -> bool:
+    return any(r.get("animation_frames") is not None or
+               fnum(r.get("dynamic_frame_gpu_ms_median")) is not None or
+               fnum(r.get("dynamic_frame_cpu_ms_median")) is not None for r in rows)
+
+
+@dataclass
+class Point:
+    """One run of a series on a scene."""
+
+    row: dict
+    series: str
+    status: str
+    x: Optional[float]  # frame time, ms (static; dynamic on an animated scene)
+    x_iqr: Optional[float]
+    y: Optional[float]  # HDR-FLIP vs full reference (mean over the frames when animated)
+    y_sigma: Optional[float]  # its ±1σ from the reference noise (None: not recorded)
+    y2: Optional[float]  # indirect relMSE
+    rung: str = ""
+    paper: Optional[bool] = None
+    cpu_clock: bool = False  # x is a CPU-clock time (no timestamps)
+
+    @property
+    def ranked(self) -> bool:
+        return self.status == "ok" and self.x is not None and self.y is not None
+
+    @property
+    def key(self) -> str:
+        return fstr(self.row.get("key"))
+
+
+def make_point(row: dict, series: str, animated: bool, ladders: dict[str, set[str]]) -> Point:
+    prefix = "dynamic_frame" if animated else "frame"
+    x, iqr = fnum(row.get(f"{prefix}_gpu_ms_median")), fnum(row.get(f"{prefix}_gpu_ms_iqr"))
+    cpu = False
+    if x is None:
+        x, iqr = fnum(row.get(f"{prefix}_cpu_ms_median")), fnum(row.get(f"{prefix}_cpu_ms_iqr"))
+        cpu = x is not None
+    y = fnum(row.get("sequence.full.flip_mean")) if animated else None
+    sigma = None
+    if y is None:
+        y, sigma = fnum(row.get("full.flip")), fnum(row.get("full.flip_noise"))
+    return Point(row=row, series=series, status=fstr(row.get("status")) or "?", x=x, x_iqr=iqr,
+                 y=y, y_sigma=sigma, y2=fnum(row.get("indirect.rel_mse")),
+                 rung=rung_text(row, ladders), paper=is_paper_rung(row, series), cpu_clock=cpu)
+
+
+# ------------------------------------------------------------------------------------------------
+# Rules
+# ------------------------------------------------------------------------------------------------
+def pareto(points: list[Point]) -> list[Point]:
+    """The ranked points no other point beats in both respects (time <= and error <, or
+    time < and error <=); sorted by time."""
+    ranked = [p for p in points if p.ranked]
+    front = [p for p in ranked if not any(
+        (q.x <= p.x and q.y < p.y) or (q.x < p.x and q.y <= p.y) for q in ranked)]
+    return sorted(front, key=lambda p: (p.x, p.y))
+
+
+def error_tie(a: Point, best: Point) -> bool:
+    """a's error is within the error bars of best's: |e_a - e_best| <= sqrt(σ_a² + σ_best²)
+    (σ = 0 where not recorded, so then only equal errors tie)."""
+    bound = math.hypot(a.y_sigma or 0.0, best.y_sigma or 0.0)
+    return abs(a.y - best.y) <= bound
+
+
+def time_tie(a: Point, best: Point) -> bool:
+    """a's frame time is within the timing IQRs of best's: |t_a - t_best| <= (IQR_a +
+    IQR_best) / 2 (the two centred IQR intervals overlap)."""
+    return abs(a.x - best.x) <= ((a.x_iqr or 0.0) + (best.x_iqr or 0.0)) / 2.0
+
+
+@dataclass
+class Cell:
+    """One table cell: a series' best point for a budget/target (None: none qualifies)."""
+
+    point: Optional[Point] = None
+    best: bool = False  # the column's best
+    tie: bool = False  # not the best but inseparable from it
+
+
+def _mark(cells: dict[str, Cell], value, tie) -> list[str]:
+    """Marks the best and the ties of one column; returns the winners (best first, then ties,
+    by name)."""
+    have = {s: c for s, c in cells.items() if c.point is not None}
+    if not have:
+        return []
+    best_name = min(have, key=lambda s: (value(have[s].point), have[s].point.x, s))
+    best = have[best_name].point
+    have[best_name].best = True
+    ties = sorted(s for s, c in have.items() if s != best_name and tie(c.point, best))
+    for s in ties:
+        have[s].tie = True
+    return [best_name] + ties
+
+
+@dataclass
+class Column:
+    label: str  # "≤ 50 ms" or "FLIP ≤ 0.700"
+    limit: float
+    cells: dict[str, Cell] = field(default_factory=dict)  # series -> cell
+    winners: list[str] = field(default_factory=list)  # best first, then the ties
+
+
+def equal_time(series_points: dict[str, list[Point]], budgets: Iterable[float]) -> list[Column]:
+    """Per budget B: each series' lowest error among its ranked points with time <= B."""
+    out = []
+    for b in budgets:
+        col = Column(label=f"≤ {b:g} ms", limit=b)
+        for s, pts in series_points.items():
+            ok = [p for p in pts if p.ranked and p.x <= b]
+            col.cells[s] = Cell(min(ok, key=lambda p: (p.y, p.x)) if ok else None)
+        col.winners = _mark(col.cells, lambda p: p.y, error_tie)
+        out.append(col)
+    return out
+
+
+def error_targets(floor: Optional[float], fractions: Iterable[float]) -> list[float]:
+    """fraction x the direct floor, each once; none without a positive floor (the door-closed
+    scene's black reference gives the floor 0)."""
+    if floor is None or floor <= 0:
+        return []
+    return sorted({f * floor for f in fractions if f > 0}, reverse=True)
+
+
+def equal_error(series_points: dict[str, list[Point]], targets: Iterable[float]
+                ) -> list[Column]:
+    """Per target E: each series' least time among its ranked points with error <= E."""
+    out = []
+    for t in targets:
+        col = Column(label=f"HDR-FLIP ≤ {sig3(t)}", limit=t)
+        for s, pts in series_points.items():
+            ok = [p for p in pts if p.ranked and p.y <= t]
+            col.cells[s] = Cell(min(ok, key=lambda p: (p.x, p.y)) if ok else None)
+        col.winners = _mark(col.cells, lambda p: p.x, time_tie)
+        out.append(col)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# Scenes
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class SceneStudy:
+    scene: str
+    animated: bool
+    points: list[Point]
+    series: dict[str, list[Point]]  # series -> its points (all statuses), by time
+    front: list[Point]
+    equal_time: list[Column]
+    equal_error: list[Column]
+    direct_floor: Optional[Point]  # the baseline's best ranked point
+    direct_light_flip: Optional[float]  # direct.flip: emission+direct vs the reference's
+    direct_light_energy: Optional[float]
+    direct_light_leak: Optional[float]
+    reference_spp: list[float]
+    flip_noise: Optional[float]  # median full.flip_noise of the scene's runs (None: none)
+    rel_mse_noise_floor: Optional[float]  # median full.rel_mse_noise_floor
+    flip_floor: Optional[float]  # median full.flip_floor: HDR-FLIP of the noise alone
+    device: str
+
+    def best(self, series: str) -> Optional[Point]:
+        ranked = [p for p in self.series.get(series, []) if p.ranked]
+        return min(ranked, key=lambda p: (p.y, p.x)) if ranked else None
+
+
+def _median(values: list[Optional[float]]) -> Optional[float]:
+    vals = [v for v in values if v is not None]
+    return statistics.median(vals) if vals else None
+
+
+def device_name(rows: list[dict]) -> str:
+    """'llvmpipe (…) (lavapipe, CPU)' / 'NVIDIA H200 (GPU)'; several joined by ' and '."""
+    names = []
+    for r in rows:
+        name = fstr(r.get("device"))
+        if not name:
+            continue
+        kind = fstr(r.get("device_type"))
+        label = f"{name} (lavapipe, CPU)" if kind == "cpu" else f"{name} (GPU)" \
+            if kind in ("discrete", "integrated", "gpu", "virtual") else \
+            (f"{name} ({kind})" if kind else name)
+        if label not in names:
+            names.append(label)
+    return " and ".join(names) or "unknown device"
+
+
+def machine_label(rows: list[dict]) -> str:
+    """Hosts with their CPU: 'vm (AMD EPYC, 2 threads)'."""
+    out = []
+    for r in rows:
+        host = fstr(r.get("host")).split(".")[0]
+        if not host:
+            continue
+        cpu, threads = fstr(r.get("cpu")), fnum(r.get("hardware_threads"))
+        extra = ", ".join(x for x in (cpu, f"{threads:.0f} threads" if threads else "") if x)
+        label = f"{host} ({extra})" if extra else host
+        if label not in out:
+            out.append(label)
+    return ", ".join(out) or "unknown machine"
+
+
+def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
+                  ladders: dict[str, set[str]], budgets: Iterable[float],
+                  fractions: Iterable[float]) -> SceneStudy:
+    animated = animated_scene(rows)
+    points = [make_point(r, series_name(r, names), animated, ladders) for r in rows]
+    series: dict[str, list[Point]] = {}
+    for p in sorted(points, key=lambda p: (p.x is None, p.x or 0.0, p.y or 0.0)):
+        series.setdefault(p.series, []).append(p)
+    series = dict(sorted(series.items()))
+    baseline = [p for p in points if fstr(p.row.get("technique")) == BASELINE and p.ranked]
+    floor = min(baseline, key=lambda p: (p.y, p.x)) if baseline else None
+    dl = next((p.row for p in baseline), None) or next(
+        (r for r in rows if fnum(r.get("direct.flip")) is not None), {})
+    return SceneStudy(
+        scene=scene, animated=animated, points=points, series=series, front=pareto(points),
+        equal_time=equal_time(series, budgets),
+        equal_error=equal_error(series, error_targets(floor.y if floor else None, fractions)),
+        direct_floor=floor, direct_light_flip=fnum(dl.get("direct.flip")),
+        direct_light_energy=fnum(dl.get("direct.energy_ratio")),
+        direct_light_leak=fnum(dl.get("direct.shadow_leak")),
+        reference_spp=sorted({v for v in (fnum(r.get("reference_samples")) for r in rows)
+                              if v is not None}),
+        flip_noise=_median([fnum(r.get("full.flip_noise")) for r in rows]),
+        rel_mse_noise_floor=_median([fnum(r.get("full.rel_mse_noise_floor")) for r in rows]),
+        flip_floor=_median([fnum(r.get("full.flip_floor")) for r in rows]),
+        device=device_name(rows))
+
+
+# ------------------------------------------------------------------------------------------------
+# Where it breaks
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class Breaks:
+    series: str
+    leak: Optional[bool] = None  # None: not measured (rooms_closed not run)
+    leak_words: str = ""
+    energy_min: Optional[float] = None
+    energy_max: Optional[float] = None
+    energy_min_scene: str = ""
+    energy_max_scene: str = ""
+    energy_flag: bool = False
+    temporal: list[tuple[str, float, Optional[float]]] = field(default_factory=list)
+    temporal_flag: bool = False
+    setup_min: Optional[float] = None  # runs that built everything (no cached precomputation)
+    setup_max: Optional[float] = None
+    cached_setup_min: Optional[float] = None  # runs that loaded it from the cache
+    cached_setup_max: Optional[float] = None
+    unsupported: list[str] = field(default_factory=list)  # "scene: reason"
+    nonfinite: list[str] = field(default_factory=list)
+    invalid: list[str] = field(default_factory=list)
+    audit: list[str] = field(default_factory=list)  # "case: grade (numbers)"
+
+    def flags(self) -> list[str]:
+        """Short names of what broke (for the at-a-glance table)."""
+        out = []
+        if self.leak:
+            out.append(f"leak ({LEAK_CLOSED})")
+        if self.energy_flag:
+            out.append("energy outside [0.5, 2]")
+        if self.temporal_flag:
+            out.append("temporal instability")
+        if self.nonfinite:
+            out.append("NaN/Inf")
+        if self.unsupported:
+            out.append("unsupported")
+        if self.invalid:
+            out.append("validation")
+        return out
+
+
+def _leak(series: str, closed: list[Point], opened: list[Point]) -> tuple[Optional[bool], str]:
+    """The leak rule on the door-closed scene (room B gets no light at all there): per rung,
+    energy_ratio(closed) / energy_ratio(open) > LEAK_RATIO where both are finite; else
+    (the closed reference is black, its energy ratio undefined) HDR-FLIP vs that black
+    reference > LEAK_FLIP; and, where the EXRs were read, the indirect light seen with the door
+    closed over the open reference's indirect light > LEAK_SHARE."""
+    measured = [p for p in closed if p.status in ("ok", "nonfinite")]
+    if not measured:
+        return None, "not run" if not closed else "no measured run"
+    by_rung = {p.rung: p for p in opened if p.status in ("ok", "nonfinite")}
+    words, leak = [], False
+    ratios = []
+    for p in measured:
+        e_closed = fnum(p.row.get("energy_ratio"))
+        o = by_rung.get(p.rung)
+        e_open = fnum(o.row.get("energy_ratio")) if o is not None else None
+        if e_closed is not None and e_open:
+            ratios.append(e_closed / e_open)
+    if ratios:
+        worst = max(ratios)
+        leak |= worst > LEAK_RATIO
+        words.append(f"energy closed/open ≤ {sig3(worst)}")
+    flips = [p.y for p in measured if p.y is not None]
+    if flips:
+        leak |= max(flips) > LEAK_FLIP
+        words.append(f"HDR-FLIP vs black ≤ {sig3(max(flips))}")
+    shares = [fnum(p.row.get("leak.share")) for p in measured]
+    shares = [s for s in shares if s is not None]
+    if shares:
+        leak |= max(shares) > LEAK_SHARE
+        words.append(f"seen {sig3(100 * max(shares))} % of the open room's indirect")
+    if not words:
+        return None, "no leak measure"
+    return leak, ", ".join(words)
+
+
+def load_audit(path: Optional[str]) -> dict[str, list[str]]:
+    """technique -> its thin-wall / leak cells of an audit.json ('case: grade, leak …');
+    {} when the file is missing or unreadable."""
+    if not path or not os.path.isfile(path):
+        return {}
+    try:
+        with open(path, encoding="utf-8") as f:
+            data = json.load(f)
+    except (OSError, ValueError):
+        return {}
+    out: dict[str, list[str]] = {}
+    cells = data.get("cells") if isinstance(data, dict) else None
+    for c in cells if isinstance(cells, list) else []:
+        if not isinstance(c, dict):
+            continue
+        case = fstr(c.get("case"))
+        if not (case.startswith(THIN_WALL_CASES) or fnum(c.get("leak")) is not None):
+            continue
+        numbers = [f"{k.replace('_', ' ')} {sig3(fnum(c.get(k)))}"
+                   for k in ("leak", "energy_ratio") if fnum(c.get(k)) is not None]
+        out.setdefault(fstr(c.get("technique")), []).append(
+            f"{case}: {fstr(c.get('grade')) or '?'}" + (f" ({', '.join(numbers)})"
+                                                        if numbers else ""))
+    return out
+
+
+def _matched_instability(p: "Point") -> Optional[float]:
+    return fnum(p.row.get("sequence.temporal_matched.instability"))
+
+
+def _lowest_instability(study: "Study") -> dict[str, float]:
+    """Per animated scene, the lowest matched temporal instability of any GI (non-baseline)
+    run: the reference point of the temporal flag."""
+    out: dict[str, float] = {}
+    for sc, st in study.scenes.items():
+        values = [_matched_instability(p) for s, pts in st.series.items()
+                  if not s.startswith(BASELINE) for p in pts if p.status in ("ok", "nonfinite")]
+        values = [v for v in values if v is not None]
+        if values:
+            out[sc] = min(values)
+    return out
+
+
+def breaks(study: "Study", audit: dict[str, list[str]]) -> list[Breaks]:
+    out = []
+    lowest = _lowest_instability(study)
+    for s in study.series:
+        b = Breaks(series=s)
+        per_scene = {sc: st.series.get(s, []) for sc, st in study.scenes.items()}
+        b.leak, b.leak_words = _leak(s, per_scene.get(LEAK_CLOSED, []),
+                                     per_scene.get(LEAK_OPEN, []))
+        energies: list[tuple[float, str]] = []
+        setups, cached = [], []
+        for sc, pts in per_scene.items():
+            for p in pts:
+                where = f"{sc} {p.rung}".strip()
+                if p.status == "unsupported":
+                    b.unsupported.append(f"{where}: {fstr(p.row.get('reason'))}".rstrip(": "))
+                elif p.status == "nonfinite":
+                    b.nonfinite.append(where)
+                elif p.status == "invalid":
+                    b.invalid.append(where)
+                if p.status not in ("ok", "nonfinite"):
+                    continue
+                e = fnum(p.row.get("energy_ratio"))
+                if e is not None and sc != LEAK_CLOSED and fnum(p.row.get("bounces")) != 0:
+                    energies.append((e, sc))
+                if fnum(p.row.get("setup_ms")) is not None:
+                    (cached if cached_setup(p.row) else setups).append(fnum(p.row.get("setup_ms")))
+                inst = _matched_instability(p)
+                if inst is not None:
+                    floor = fnum(p.row.get("sequence.temporal_matched.noise_floor"))
+                    b.temporal.append((sc, inst, floor))
+                    if (not s.startswith(BASELINE) and sc in lowest
+                            and inst > TEMPORAL_FACTOR * lowest[sc]):
+                        b.temporal_flag = True
+        if energies and not s.startswith(BASELINE):
+            (b.energy_min, b.energy_min_scene), (b.energy_max, b.energy_max_scene) = (
+                min(energies), max(energies))
+            b.energy_flag = b.energy_min < ENERGY_BAND[0] or b.energy_max > ENERGY_BAND[1]
+        if setups:
+            b.setup_min, b.setup_max = min(setups), max(setups)
+        if cached:
+            b.cached_setup_min, b.cached_setup_max = min(cached), max(cached)
+        b.audit = audit.get(s.split(" (")[0], [])
+        out.append(b)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# The whole study
+# ------------------------------------------------------------------------------------------------
+@dataclass
+class Study:
+    scenes: dict[str, SceneStudy]
+    series: list[str]
+    budgets: tuple[float, ...]
+    fractions: tuple[float, ...]
+    breaks: list[Breaks]
+    device: str
+    machine: str
+    rows: list[dict]
+    statuses: dict[str, int]
+    commits: list[str]
+
+    def scene_best(self, scene: str, series: str) -> Optional[Point]:
+        return self.scenes[scene].best(series)
+
+
+def by_device(rows: list[dict]) -> dict[str, list[dict]]:
+    """Rows by device model (device_name): times of two models are never compared."""
+    out: dict[str, list[dict]] = {}
+    for r in rows:
+        out.setdefault(device_name([r]), []).append(r)
+    return dict(sorted(out.items(), key=lambda kv: -len(kv[1])))
+
+
+def is_study(rows: list[dict]) -> bool:
+    """Two or more techniques measured on one scene: the cross-technique view applies."""
+    techs: dict[str, set[str]] = {}
+    for r in rows:
+        if fstr(r.get("status")) in ("ok", "nonfinite"):
+            techs.setdefault(fstr(r.get("scene")), set()).add(fstr(r.get("technique")))
+    return any(len(t) >= 2 for t in techs.values())
+
+
+def analyse(rows: list[dict], budgets: Iterable[float] = BUDGETS_MS,
+            fractions: Iterable[float] = ERROR_FRACTIONS,
+            audit: Optional[dict[str, list[str]]] = None) -> Study:
+    budgets, fractions = tuple(budgets), tuple(fractions)
+    names, ladders = series_keys(rows), ladder_keys(rows)
+    by_scene: dict[str, list[dict]] = {}
+    for r in rows:
+        by_scene.setdefault(fstr(r.get("scene")) or "?", []).append(r)
+    scenes = {s: analyse_scene(s, rs, names, ladders, budgets, fractions)
+              for s, rs in by_scene.items()}
+    series = sorted({p.series for st in scenes.values() for p in st.points},
+                    key=lambda s: (not s.startswith(BASELINE), s))
+    statuses: dict[str, int] = {}
+    for r in rows:
+        statuses[fstr(r.get("status")) or "?"] = statuses.get(fstr(r.get("status")) or "?", 0) + 1
+    study = Study(scenes=scenes, series=series, budgets=budgets, fractions=fractions, breaks=[],
+                  device=device_name(rows), machine=machine_label(rows), rows=rows,
+                  statuses=statuses,
+                  commits=sorted({fstr(r.get("git_commit")) for r in rows} - {""}))
+    study.breaks = breaks(study, audit or {})
+    return study
+
+
+# ------------------------------------------------------------------------------------------------
+# Findings: sentences that only restate the numbers
+# ------------------------------------------------------------------------------------------------
+def winners_words(col: Column) -> str:
+    if not col.winners:
+        return "no run qualifies"
+    best = col.winners[0]
+    p = col.cells[best].point
+    out = f"{best} ({sig3(p.y)} at {ms(p.x)})"
+    if len(col.winners) > 1:
+        out += ", tied within the error bars with " + ", ".join(col.winners[1:]) \
+            if "FLIP" not in col.label else ", tied within the timing IQR with " + \
+            ", ".join(col.winners[1:])
+    return out
+
+
+def restricted_winner(col: Column, excluded: str) -> Optional[str]:
+    """The column's winner when `excluded` is not allowed (None: nothing else qualifies)."""
+    cells = {s: Cell(c.point) for s, c in col.cells.items() if s != excluded}
+    key = (lambda p: p.x) if "FLIP" in col.label else (lambda p: p.y)
+    tie = time_tie if "FLIP" in col.label else error_tie
+    winners = _mark(cells, key, tie)
+    return winners[0] if winners else None
+
+
+def rung_caveat(st: "SceneStudy", ours: str, paper: str) -> str:
+    """'; the paper's variant ran 1 of our 4 rungs' when the comparison is uneven."""
+    n_ours = len({p.rung for p in st.series.get(ours, [])})
+    n_paper = len({p.rung for p in st.series.get(paper, [])})
+    if n_paper >= n_ours:
+        return ""
+    return f"; {paper} ran {n_paper} of the {n_ours} rungs {ours} ran"
+
+
+def findings(study: Study) -> list[str]:
+    """Plain sentences, each a restatement of numbers in the tables."""
+    out = []
+    for scene, st in study.scenes.items():
+        if scene in NOT_QUALITY:
+            continue
+        absent = [s for s in study.series if not any(p.ranked for p in st.series.get(s, []))]
+        if absent:
+            out.append(f"{scene}: no ranked run of {', '.join(absent)} (not run, not finished "
+                       "or not measured); the winners below are among the others.")
+        for col in st.equal_time:
+            out.append(f"{scene}, frame time {col.label}: best HDR-FLIP {winners_words(col)}.")
+        for ours, paper in our_choice_pairs(study.series):
+            for col in st.equal_time:
+                if not col.winners or col.winners[0] != ours:
+                    continue
+                alt = restricted_winner(col, ours)
+                has_paper = col.cells.get(paper) and col.cells[paper].point is not None
+                if alt is None:
+                    out.append(f"{scene}, {col.label}: only {ours} qualifies; without our choice "
+                               "no run would.")
+                elif alt != ours:
+                    same = alt.split(" (")[0] == ours.split(" (")[0]
+                    out.append(f"{scene}, {col.label}: {ours} wins; with only {paper} allowed the "
+                               f"winner would be {alt}"
+                               + (" (the same technique still wins)" if same
+                                  else " (another technique: our choice changes the ranking)")
+                               + ("" if has_paper else f"; {paper} has no run within it")
+                               + rung_caveat(st, ours, paper) + ".")
+    for s in study.series:
+        rows = [(sc, st.best(s), [p for p in st.series.get(s, []) if p.ranked and p.paper])
+                for sc, st in study.scenes.items() if sc not in NOT_QUALITY]
+        parts = []
+        for sc, best, papers in rows:
+            if best is None or not papers:
+                continue
+            paper = min(papers, key=lambda p: (p.y, p.x))
+            if paper is best:
+                parts.append(f"{sc}: the paper rung is its best ({sig3(best.y)}, {ms(best.x)})")
+            else:
+                parts.append(f"{sc}: paper rung {sig3(paper.y)} at {ms(paper.x)}, best rung "
+                             f"{best.rung} {sig3(best.y)} at {ms(best.x)}")
+        if parts:
+            out.append(f"{s}, paper rung vs best rung — " + "; ".join(parts) + ".")
+    for b in study.breaks:
+        if b.leak is not None:
+            out.append(f"{b.series} on {LEAK_CLOSED}: {'leaks' if b.leak else 'no leak'} "
+                       f"({b.leak_words}).")
+    return out
+
+
+def glance(study: Study) -> list[dict]:
+    """Per technique (all its series together): its lowest HDR-FLIP over the quality scenes
+    (scene, time, series), the median over those scenes of its best HDR-FLIP over the direct
+    floor's (how much of the error without indirect light it leaves; HDR-FLIP of two scenes is
+    not comparable, this ratio is), the scenes and budgets where one of its series wins, and
+    what broke (a flag of only some of its series names them)."""
+    out = []
+    by_series = {b.series: b for b in study.breaks}
+    quality = {sc: st for sc, st in study.scenes.items() if sc not in NOT_QUALITY}
+    techniques = list(dict.fromkeys(s.partition(" (")[0] for s in study.series))
+    for tech in techniques:
+        series = [s for s in study.series if s.partition(" (")[0] == tech]
+        bests, ratios = [], []
+        for sc, st in quality.items():
+            pts = [(st.best(s), s) for s in series if st.best(s)]
+            if not pts:
+                continue
+            p, s = min(pts, key=lambda t: (t[0].y, t[0].x))
+            bests.append((sc, p, s))
+            floor = st.direct_floor
+            if tech != BASELINE and floor is not None and floor.y and floor.y > 0:
+                ratios.append(p.y / floor.y)
+        top = min(bests, key=lambda t: (t[1].y, t[1].x)) if bests else None
+        wins: dict[str, list[str]] = {}
+        for sc, st in quality.items():
+            for col in st.equal_time:
+                if any(w in series for w in col.winners):
+                    wins.setdefault(sc, []).append(col.label.replace("≤ ", "≤").replace(" ms", ""))
+        flags: dict[str, list[str]] = {}
+        for s in series:
+            b = by_series.get(s)
+            for f in (b.flags() if b else []):
+                flags.setdefault(f, []).append(s)
+        breaks = [f if len(who) == len(series) or len(series) == 1 else
+                  f"{f} ({'; '.join(w.partition(' (')[2].rstrip(')') or w for w in who)})"
+                  for f, who in flags.items()]
+        out.append({"technique": tech, "series": series, "best": top,
+                    "floor_ratio": statistics.median(ratios) if ratios else None,
+                    "wins": wins, "breaks": breaks})
+    return out

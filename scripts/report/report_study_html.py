@@ -1,0 +1,347 @@
+"""Renderings of the cross-technique study (report_study.py): the error-against-time figure
+(SVG for the report, PNG for scripts/findings.py: one drawing function), the report's HTML
+section, and the Markdown tables of docs/findings.md. Nothing is computed here that
+report_study does not define.
+"""
+from __future__ import annotations
+
+import html
+import sys
+import textwrap
+from typing import Optional
+
+import matplotlib
+
+if "matplotlib.pyplot" not in sys.modules:  # the caller's backend otherwise (svg or agg)
+    matplotlib.use("svg")
+import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+
+import report_study as S  # noqa: E402
+from report_analysis import shade, technique_colors  # noqa: E402
+
+FRONT_COLOR = "#111111"
+STUDY_GID = "study-front-"  # + run key: the ring of a Pareto-front point (SVG id)
+
+
+def series_colors(series: list[str], tech_colors: Optional[dict[str, str]] = None
+                  ) -> dict[str, str]:
+    """The technique's colour for its only series; shades of it for several (light to dark)."""
+    techs = [s.split(" (")[0] for s in series]
+    tech_colors = tech_colors or technique_colors(techs)
+    out = {}
+    for tech in dict.fromkeys(techs):
+        mine = [s for s in series if s.split(" (")[0] == tech]
+        base = tech_colors.get(tech, "#888888")
+        for i, s in enumerate(mine):
+            out[s] = base if len(mine) == 1 else shade(base, i + 1, len(mine) + 1)
+    return out
+
+
+def _log_x(ax) -> None:
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def study_figure(st: "S.SceneStudy", colors: dict[str, str], path: str, time_label: str,
+                 size: tuple[float, float] = (9.0, 3.8), dpi: int = 100,
+                 legend: bool = True) -> None:
+    """Left: HDR-FLIP vs full reference against frame time (log), one line per series through
+    its runs (by time), ±1σ bars where recorded, IQR bars in time, the Pareto front across all
+    series as a black step line with ringed points; right: indirect relMSE (log when it spans
+    > 10x). The file format follows the extension (.svg or .png)."""
+    fig = plt.figure(figsize=size, dpi=dpi, constrained_layout=True)
+    grid = fig.add_gridspec(2, 2, height_ratios=[1.0, 0.55 if legend else 0.01])
+    ax1, ax2, box = (fig.add_subplot(grid[0, 0]), fig.add_subplot(grid[0, 1]),
+                     fig.add_subplot(grid[1, :]))
+    box.axis("off")
+    ys2 = []
+    for s, pts in st.series.items():
+        ranked = [p for p in pts if p.ranked]
+        if not ranked:
+            continue
+        c = colors.get(s, "#888888")
+        xs = [p.x for p in ranked]
+        xerr = [[p.x_iqr / 2 if p.x_iqr else 0.0 for p in ranked]] * 2
+        yerr = [p.y_sigma or 0.0 for p in ranked]
+        ax1.errorbar(xs, [p.y for p in ranked], xerr=xerr, yerr=yerr if any(yerr) else None,
+                     fmt="o-", ms=4, lw=1.2, color=c, ecolor=c, elinewidth=0.7, capsize=0,
+                     label=s)
+        paper = [p for p in ranked if p.paper]
+        if paper:
+            ax1.plot([p.x for p in paper], [p.y for p in paper], "D", ms=7, mfc="none",
+                     mec=c, mew=1.0)
+        with2 = [p for p in ranked if p.y2 is not None and p.y2 > 0]
+        if with2:
+            ax2.plot([p.x for p in with2], [p.y2 for p in with2], "o-", ms=4, lw=1.2, color=c,
+                     label=s)
+            ys2 += [p.y2 for p in with2]
+    if st.front:
+        fx, fy = [p.x for p in st.front], [p.y for p in st.front]
+        ax1.step(fx, fy, where="post", color=FRONT_COLOR, lw=1.0, ls="--", zorder=4,
+                 label="Pareto front (all series)")
+        for p in st.front:
+            ring, = ax1.plot([p.x], [p.y], "o", ms=10, mfc="none", mec=FRONT_COLOR, mew=1.0,
+                             zorder=5)
+            ring.set_gid(f"{STUDY_GID}{p.key}")
+    if st.direct_floor is not None:
+        ax1.axhline(st.direct_floor.y, color="#777777", lw=0.8, ls=":", zorder=1)
+    for ax in (ax1, ax2):
+        xs = [p.x for p in st.points if p.ranked]
+        if xs and min(xs) > 0:
+            _log_x(ax)
+        ax.set_xlabel(time_label)
+        ax.grid(True, color="#dddddd", lw=0.6)
+        ax.set_axisbelow(True)
+    basis = "dynamic frame; error: mean over the frames" if st.animated else "static frame"
+    ax1.set_ylabel("HDR-FLIP vs full reference")
+    ax1.set_title(f"{st.scene} ({basis})", fontsize=8.5)
+    ax2.set_ylabel("relMSE, indirect layer")
+    ax2.set_title("indirect layer vs the matched indirect", fontsize=8.5)
+    if ys2 and max(ys2) > 10 * min(ys2):
+        ax2.set_yscale("log")
+    if legend:
+        handles, labels = ax1.get_legend_handles_labels()
+        # Long series names (several distinguishing settings) wrap instead of widening the
+        # legend, which would squeeze both panels.
+        labels = [textwrap.fill(label, 38) for label in labels]
+        box.legend(handles, labels, loc="center", ncol=2 if size[0] < 8 else 3, fontsize=6,
+                   frameon=False)
+    fmt = "png" if path.endswith(".png") else "svg"
+    fig.savefig(path, format=fmt, dpi=dpi, metadata={"Date": None} if fmt == "svg" else None)
+    plt.close(fig)
+    if fmt == "png":
+        _quantize(path)
+
+
+def _quantize(path: str) -> None:
+    """A 128-colour palette PNG (a third of the size; plots have few colours)."""
+    try:
+        from PIL import Image
+    except ImportError:
+        return
+    with Image.open(path) as im:
+        small = im.convert("RGB").quantize(colors=128)
+    small.save(path, optimize=True)
+
+
+# ------------------------------------------------------------------------------------------------
+# HTML (the report)
+# ------------------------------------------------------------------------------------------------
+def _e(x: object) -> str:
+    return html.escape(str(x), quote=True)
+
+
+def _sw(s: str, colors: dict[str, str]) -> str:
+    return (f'<span class="sw" style="background:{colors.get(s, "#888")}"></span>{_e(s)}')
+
+
+def _cell(c: "S.Cell", value: str, tip: str) -> str:
+    if c.point is None:
+        return "<td>—</td>"
+    cls = ' class="best"' if c.best else (' class="tie"' if c.tie else "")
+    mark = " (best)" if c.best else (" (tie)" if c.tie else "")
+    return f'<td{cls} title="{_e(tip)}" data-key="{_e(c.point.key)}">{value}{mark}</td>'
+
+
+def _point_tip(p: "S.Point") -> str:
+    return (f"{p.series} {p.rung}: HDR-FLIP {S.sig3(p.y)}"
+            + (f" ± {S.sig3(p.y_sigma)}" if p.y_sigma else "") + f", {S.ms(p.x)}"
+            + (f" (IQR {S.ms(p.x_iqr)})" if p.x_iqr else "")).replace("  ", " ")
+
+
+def _table(columns: list["S.Column"], series: list[str], colors: dict[str, str], caption: str,
+           head: str, value) -> str:
+    if not columns:
+        return ""
+    rows = []
+    for s in series:
+        cells = "".join(_cell(c.cells.get(s, S.Cell()), value(c.cells[s].point)
+                              if c.cells.get(s) and c.cells[s].point else "—",
+                              _point_tip(c.cells[s].point) if c.cells.get(s) and
+                              c.cells[s].point else "")
+                        for c in columns)
+        rows.append(f"<tr><td>{_sw(s, colors)}</td>{cells}</tr>")
+    winners = "".join(f"<td>{_e(', '.join(c.winners) or '—')}</td>" for c in columns)
+    heads = "".join(f"<th>{_e(c.label)}</th>" for c in columns)
+    return (f'<table class="data study"><caption class="device-line">{caption}</caption>'
+            f"<thead><tr><th>{_e(head)}</th>{heads}</tr></thead><tbody>{''.join(rows)}"
+            f'<tr class="winners"><td>best (and ties)</td>{winners}</tr></tbody></table>')
+
+
+def breaks_table(study: "S.Study", colors: dict[str, str], caption: str, device: str) -> str:
+    rows = []
+    for b in study.breaks:
+        temporal = "; ".join(f"{sc} {S.sig3(v)}" + (f" (floor {S.sig3(f)})" if f else "")
+                             for sc, v, f in b.temporal) or "—"
+        fails = "; ".join([f"unsupported: {x}" for x in b.unsupported]
+                          + [f"NaN/Inf: {x}" for x in b.nonfinite]
+                          + [f"validation: {x}" for x in b.invalid]) or "—"
+        leak = {None: "—", True: "leaks", False: "no"}[b.leak]
+        energy = energy_range(b)
+        setup = setup_range(b)
+        flag = ' class="flag"'
+        rows.append(
+            f"<tr><td>{_sw(b.series, colors)}</td>"
+            f"<td{flag if b.leak else ''}>{leak}<br><small>{_e(b.leak_words)}</small></td>"
+            f"<td{flag if b.energy_flag else ''}>{energy}</td>"
+            f"<td{flag if b.temporal_flag else ''}>{_e(temporal)}</td><td>{setup}</td>"
+            f"<td{flag if fails != '—' else ''}>{_e(fails)}</td>"
+            f"<td>{_e('; '.join(b.audit) or '—')}</td></tr>")
+    return (f'<table class="data study breaks"><caption class="device-line">{caption}</caption>'
+            f"<thead><tr><th>series</th><th>leak ({S.LEAK_CLOSED} vs {S.LEAK_OPEN})</th>"
+            f"<th>energy ratio range (indirect vs bounce-matched)</th>"
+            f"<th>temporal instability vs the bounce-matched frames (animated scenes)</th>"
+            f"<th>set-up, {_e(device)}, ms (range)</th><th>unsupported / NaN / invalid</th>"
+            f"<th>audit: thin-wall and leak cells</th></tr></thead>"
+            f"<tbody>{''.join(rows)}</tbody></table>")
+
+
+RULES_HTML = (
+    "<p class=\"rules\">Series: a technique, split by the parameters that are not on its ladder "
+    "but differ between its runs of a scene (cvgi's <code>gather</code>). x: the median frame "
+    "time (static frame; on animated scenes the dynamic frame with its update); error: mean "
+    "HDR-FLIP vs the full reference (animated: the mean over the measured frames). "
+    "<b>Pareto front</b>: runs of all series that no run beats in both time and error. "
+    "<b>Equal time</b>: each series' lowest error with frame time ≤ the budget; a series is "
+    "<b>tied</b> with the best when |e − e<sub>best</sub>| ≤ √(σ² + σ<sub>best</sub>²), σ the "
+    "HDR-FLIP error bar from the reference noise (0 where not recorded: then only equal "
+    "errors tie). <b>Equal error</b>: targets are {fractions} × the scene's direct floor (the "
+    "<code>direct</code> run's HDR-FLIP); each series' least time reaching the target; tied "
+    "when |t − t<sub>best</sub>| ≤ (IQR + IQR<sub>best</sub>) / 2. <b>Leak</b> (door closed: "
+    "room B must stay black): energy ratio closed/open of a rung > {ratio}, or HDR-FLIP vs the "
+    "black reference > {flip}, or indirect light seen with the door closed > {share} % of the "
+    "open room's reference indirect light. Energy ratio flagged outside [{e0}, {e1}]; temporal "
+    "instability (against the bounce-matched frames) flagged above {tf} × the lowest of any GI "
+    "technique on the scene. docs/report.md, \"Cross-technique "
+    "study\".</p>")
+
+
+def rules_html(study: "S.Study") -> str:
+    return RULES_HTML.format(fractions="/".join(f"{f:g}" for f in study.fractions),
+                             ratio=f"{S.LEAK_RATIO:g}", flip=f"{S.LEAK_FLIP:g}",
+                             share=f"{100 * S.LEAK_SHARE:g}", e0=f"{S.ENERGY_BAND[0]:g}",
+                             e1=f"{S.ENERGY_BAND[1]:g}", tf=f"{S.TEMPORAL_FACTOR:g}")
+
+
+def study_section_html(study: "S.Study", colors: dict[str, str],
+                       figures: dict[str, str], figure_url, device_label: str,
+                       first: bool = True) -> str:
+    """The report's cross-technique section (id="study" on the first device's block);
+    figures: scene -> SVG path; figure_url: path -> relative URL; device_label: the time
+    headers' device words. '' when no scene has two measured series."""
+    shown = [sc for sc, st in study.scenes.items()
+             if len({p.series for p in st.points if p.ranked}) >= 2]
+    if not shown:
+        return ""
+    caption = f"timed on {_e(study.device)}; machine {_e(study.machine)}"
+    head = ('<h2 id="study">Cross-technique study: every series along its ladder</h2>'
+            + rules_html(study)) if first else ""
+    parts = [head, f'<p class="device-line">Timed on {_e(study.device)}, machine '
+             f'{_e(study.machine)}.</p>']
+    for scene, st in study.scenes.items():
+        if scene not in shown:
+            continue
+        series = [s for s in study.series if s in st.series]
+        parts.append(f'<h3 class="study-scene">{_e(scene)}</h3>')
+        floor = st.direct_floor
+        if scene in S.NOT_QUALITY:
+            parts.append('<p class="warn">A leak test: the path tracer shows this view black, '
+                         "so every error below is light that leaked (see \"Where it breaks\"); "
+                         "it is left out of the findings' winners.</p>")
+        parts.append(
+            f'<p class="floor">Direct floor: HDR-FLIP {S.sig3(floor.y) if floor else "—"} vs '
+            f"the full reference ({S.ms(floor.x) if floor else '—'}). The shared direct light's "
+            f"own error (emission+direct vs the reference's, <code>metrics.direct</code>): "
+            f"HDR-FLIP {S.sig3(st.direct_light_flip)}, energy "
+            f"{S.sig3(st.direct_light_energy)}, shadow leak "
+            f"{S.sig3(100 * st.direct_light_leak) if st.direct_light_leak is not None else '—'}"
+            f" %. Reference {', '.join(f'{v:g}' for v in st.reference_spp) or '—'} spp; "
+            f"relMSE noise floor {S.sig3(st.rel_mse_noise_floor)}; HDR-FLIP noise floor "
+            f"{S.sig3(st.flip_floor) if st.flip_floor is not None else 'not recorded'}; "
+            f"HDR-FLIP error bar "
+            f"{S.sig3(st.flip_noise) if st.flip_noise is not None else 'not recorded'}.</p>")
+        if scene in figures:
+            url = figure_url(figures[scene])
+            parts.append(
+                f'<figure class="plot"><a href="{url}"><img src="{url}" alt="{_e(scene)}: '
+                f'error against frame time, every series" onerror="gilabImageError(this)"></a>'
+                f"<figcaption>Every series' runs joined by time; black dashed step and rings: "
+                f"the Pareto front across all series; diamonds: the paper's rung; dotted line: "
+                f"the direct floor. {caption}.</figcaption></figure>")
+        parts.append("<h4>Equal time: best HDR-FLIP vs full reference within each budget</h4>")
+        parts.append(_table(st.equal_time, series, colors, caption, "series",
+                            lambda p: f"{S.sig3(p.y)} <small>({S.ms(p.x)})</small>"))
+        parts.append(f"<h4>Equal error: least frame time ({_e(device_label)}) to reach each "
+                     "HDR-FLIP target</h4>")
+        parts.append(_table(st.equal_error, series, colors, caption, "series",
+                            lambda p: f"{S.ms(p.x)} <small>({S.sig3(p.y)})</small>")
+                     or "<p>No direct floor on this scene: no targets.</p>")
+    parts.append("<h3>Where it breaks</h3>")
+    parts.append(breaks_table(study, colors, caption, device_label))
+    return "".join(parts)
+
+
+# ------------------------------------------------------------------------------------------------
+# Markdown (docs/findings.md)
+# ------------------------------------------------------------------------------------------------
+def _md_cell(c: "S.Cell", value: str) -> str:
+    if c.point is None:
+        return "—"
+    return f"**{value}**" if c.best else (f"{value} (tie)" if c.tie else value)
+
+
+def md_table(columns: list["S.Column"], series: list[str], value) -> str:
+    if not columns:
+        return "(no targets: no direct floor)\n"
+    out = ["| series | " + " | ".join(c.label for c in columns) + " |",
+           "|---|" + "---|" * len(columns)]
+    for s in series:
+        out.append(f"| {s} | " + " | ".join(
+            _md_cell(c.cells.get(s, S.Cell()), value(c.cells[s].point)
+                     if c.cells.get(s) and c.cells[s].point else "—") for c in columns) + " |")
+    out.append("| best (and ties) | " + " | ".join(", ".join(c.winners) or "—"
+                                                  for c in columns) + " |")
+    return "\n".join(out) + "\n"
+
+
+def setup_range(b: "S.Breaks") -> str:
+    """'a – b' over the runs that built everything, then '(cached: c – d)' where a run loaded
+    its precomputation from the cache (topovpl's topology)."""
+    out = f"{S.sig3(b.setup_min)} – {S.sig3(b.setup_max)}" if b.setup_min is not None else ""
+    if b.cached_setup_min is not None:
+        out += (" " if out else "") + (f"(cached: {S.sig3(b.cached_setup_min)} – "
+                                        f"{S.sig3(b.cached_setup_max)})")
+    return out or "—"
+
+
+def energy_range(b: "S.Breaks") -> str:
+    """'0.3 (scene) – 2.2 (scene)': the extremes of the energy ratio and where."""
+    if b.energy_min is None:
+        return "—"
+    return (f"{S.sig3(b.energy_min)} ({b.energy_min_scene}) – "
+            f"{S.sig3(b.energy_max)} ({b.energy_max_scene})")
+
+
+def md_breaks(study: "S.Study") -> str:
+    out = ["| series | leak (rooms_closed) | energy ratio range | temporal instability (matched) | "
+           "set-up ms | unsupported / NaN / invalid | audit thin-wall/leak cells |",
+           "|---|---|---|---|---|---|---|"]
+    for b in study.breaks:
+        leak = {None: "—", True: "**leaks**", False: "no"}[b.leak]
+        out.append(
+            f"| {b.series} | {leak} ({b.leak_words}) | "
+            + (energy_range(b) + (" **outside**" if b.energy_flag else "")
+               if b.energy_min is not None else "—")
+            + " | " + ("; ".join(f"{sc} {S.sig3(v)} (floor {S.sig3(f)})"
+                                  for sc, v, f in b.temporal) or "—")
+            + (" **unstable**" if b.temporal_flag else "") + " | "
+            + (setup_range(b) if b.setup_min is not None or b.cached_setup_min is not None
+               else "—") + " | "
+            + ("; ".join([f"unsupported: {x}" for x in b.unsupported]
+                         + [f"NaN/Inf: {x}" for x in b.nonfinite]
+                         + [f"validation: {x}" for x in b.invalid]) or "—").replace("|", "/")
+            + " | " + ("; ".join(b.audit) or "—") + " |")
+    return "\n".join(out) + "\n"
