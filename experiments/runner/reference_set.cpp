@@ -80,7 +80,8 @@ MatchedReference ReferenceSet::match(int bounces) const {
     for (int b = 0; b < bounces; ++b) {
         finalLayers.push_back(kBounces[b]);
         indirectLayers.push_back(kBounces[b]);
-        m.name += "+" + std::string(ref::layerName(kBounces[b]));
+        m.name += '+';
+        m.name += ref::layerName(kBounces[b]);
     }
     Image var;
     for (Layer l : finalLayers) {
