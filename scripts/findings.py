@@ -111,7 +111,10 @@ def ladders_md(study: "S.Study") -> list[str]:
 def write_findings(results: str, out: str, glance_path: str, audit: str | None,
                    budgets: tuple[float, ...], fractions: tuple[float, ...],
                    argv: list[str]) -> tuple[str, str, list[str]]:
-    all_rows = S.load_rows([results])
+    bad: list[str] = []
+    all_rows = S.load_rows([results], bad)
+    for b in bad:
+        print(f"findings: warning: left out an unreadable run: {b}", file=sys.stderr)
     groups = list(S.by_device(all_rows).items())  # the device model with the most runs first
     rows = groups[0][1] if groups else []
     others = [f"{len(g)} runs on {name}" for name, g in groups[1:]]
@@ -128,13 +131,16 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
           f"- commit `{git_commit()}` (the runs: {', '.join(study.commits) or 'unknown'})",
           f"- device: {study.device}; machine: {study.machine}",
           f"- date: {date}",
-          f"- regenerate: `{command}` (the runs: `build/gilab run "
-          "experiments/configs/study.json`)",
+          f"- regenerate: `{command}`"
+          + (f" (the runs: `build/gilab run {info['config_path']}`)"
+             if isinstance(info.get("config_path"), str) else ""),
           f"- runs: {len(all_rows)} finished"
           + (f" of {total} planned ({total - len(all_rows)} not finished)"
              if isinstance(total, int) else "")
-          + " — " + ", ".join(f"{n} {s}" for s, n in sorted(study.statuses.items()))
-          + (f"; not compared (another device model): {'; '.join(others)}" if others else ""),
+          + " — " + (", ".join(f"{n} {s}" for s, n in sorted(study.statuses.items()))
+                     or "none")
+          + (f"; not compared (another device model): {'; '.join(others)}" if others else "")
+          + (f"; {len(bad)} unreadable run folder(s) left out: {'; '.join(bad)}" if bad else ""),
           "- rules (ties, targets, leaks): docs/report.md, \"Cross-technique study\"; "
           f"budgets {_fmt_list(list(budgets))} ms; equal-error targets "
           f"{_fmt_list(list(fractions))} × the direct floor.", ""]

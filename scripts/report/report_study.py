@@ -20,6 +20,8 @@ import statistics
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Optional
 
+from report_data import dig
+
 # ------------------------------------------------------------------------------------------------
 # Rules and thresholds (docs/report.md, "Cross-technique study")
 # ------------------------------------------------------------------------------------------------
@@ -36,8 +38,8 @@ ENERGY_BAND = (0.5, 2.0)  # energy ratio outside: flagged (the audit's amber ban
 # Temporal instability against the bounce-matched frames (flicker and lag of the light the
 # technique claims; vs the full frames the missing bounces' change would dominate): flagged
 # above this x the lowest instability of any GI series on the same scene. Every GI series
-# measures several x the reference noise floor on the study's sequences (the error pattern
-# moves with the light), so an absolute floor rule would flag them all.
+# measured 2.5-6.2x the reference noise floor on the study's sequences, so an absolute floor
+# rule would flag them all.
 TEMPORAL_FACTOR = 1.5
 # Scenes that test a failure, not quality: the door-closed rooms' reference is black, so an
 # error there is a leak; they are left out of the findings' winners and the glance table.
@@ -143,75 +145,69 @@ def ms(x: Optional[float]) -> str:
 # ------------------------------------------------------------------------------------------------
 # Rows
 # ------------------------------------------------------------------------------------------------
-def _at(data: Any, *path: str) -> Any:
-    for step in path:
-        if not isinstance(data, dict):
-            return None
-        data = data.get(step)
-    return data
 
 
 def _metric_columns(row: dict, prefix: str, m: Any) -> None:
     if not isinstance(m, dict):
         return
-    row[f"{prefix}.flip"] = _at(m, "flip", "mean")
-    row[f"{prefix}.flip_noise"] = _at(m, "error_bars", "flip", "spread")
+    row[f"{prefix}.flip"] = dig(m, "flip", "mean")
+    row[f"{prefix}.flip_noise"] = dig(m, "error_bars", "flip", "spread")
     # The HDR-FLIP of the reference's own noise (an exact image would score this).
-    row[f"{prefix}.flip_floor"] = _at(m, "error_bars", "flip", "floor_mean")
+    row[f"{prefix}.flip_floor"] = dig(m, "error_bars", "flip", "floor_mean")
     row[f"{prefix}.rel_mse"] = m.get("rel_mse")
-    row[f"{prefix}.rel_mse_noise_floor"] = _at(m, "error_bars", "rel_mse_noise_floor")
+    row[f"{prefix}.rel_mse_noise_floor"] = dig(m, "error_bars", "rel_mse_noise_floor")
 
 
 def row_from_result(data: dict) -> dict:
     """The runner's row (run_store.cpp resultRow, the columns this module reads) of a
     result.json, plus host, cpu and the direct light's energy ratio and shadow leak."""
     d = data if isinstance(data, dict) else {}
-    params = _at(d, "technique", "params")
-    swept = _at(d, "technique", "swept")
+    params = dig(d, "technique", "params")
+    swept = dig(d, "technique", "swept")
     row: dict = {
-        "key": d.get("key"), "scene": _at(d, "scene", "label"),
-        "technique": _at(d, "technique", "id"), "status": d.get("status"),
-        "bounces": _at(d, "technique", "indirect_bounces"),
+        "key": d.get("key"), "scene": dig(d, "scene", "label"),
+        "technique": dig(d, "technique", "id"), "status": d.get("status"),
+        "bounces": dig(d, "technique", "indirect_bounces"),
         "reason": d.get("reason"), "swept": " ".join(swept) if isinstance(swept, dict) else "",
-        "setup_ms": _at(d, "timing", "setup_ms", "total"),
-        "topology_cache_hit": _at(d, "stats", "topology_cache_hit"),
-        "frame_gpu_ms_median": _at(d, "timing", "frame_gpu_ms", "median"),
-        "frame_gpu_ms_iqr": _at(d, "timing", "frame_gpu_ms", "iqr"),
-        "frame_cpu_ms_median": _at(d, "timing", "frame_cpu_ms", "median"),
-        "frame_cpu_ms_iqr": _at(d, "timing", "frame_cpu_ms", "iqr"),
-        "reference_samples": _at(d, "reference", "samples"),
-        "reference_matched": _at(d, "reference", "matched"),
-        "energy_ratio": _at(d, "metrics", "energy_ratio"),
-        "direct.energy_ratio": _at(d, "metrics", "direct", "energy_ratio"),
-        "direct.shadow_leak": _at(d, "metrics", "direct", "shadow_leak"),
-        "device": _at(d, "device", "name"), "device_type": _at(d, "device", "type"),
-        "host": d.get("host") or _at(d, "provenance", "host"),
-        "cpu": _at(d, "provenance", "cpu"),
-        "hardware_threads": _at(d, "provenance", "hardware_threads"),
-        "git_commit": _at(d, "provenance", "git_commit"), "date": _at(d, "provenance", "date"),
+        "setup_ms": dig(d, "timing", "setup_ms", "total"),
+        "topology_cache_hit": dig(d, "stats", "topology_cache_hit"),
+        "frame_gpu_ms_median": dig(d, "timing", "frame_gpu_ms", "median"),
+        "frame_gpu_ms_iqr": dig(d, "timing", "frame_gpu_ms", "iqr"),
+        "frame_cpu_ms_median": dig(d, "timing", "frame_cpu_ms", "median"),
+        "frame_cpu_ms_iqr": dig(d, "timing", "frame_cpu_ms", "iqr"),
+        "reference_samples": dig(d, "reference", "samples"),
+        "reference_matched": dig(d, "reference", "matched"),
+        "energy_ratio": dig(d, "metrics", "energy_ratio"),
+        "direct.energy_ratio": dig(d, "metrics", "direct", "energy_ratio"),
+        "direct.shadow_leak": dig(d, "metrics", "direct", "shadow_leak"),
+        "device": dig(d, "device", "name"), "device_type": dig(d, "device", "type"),
+        "host": d.get("host") or dig(d, "provenance", "host"),
+        "cpu": dig(d, "provenance", "cpu"),
+        "hardware_threads": dig(d, "provenance", "hardware_threads"),
+        "git_commit": dig(d, "provenance", "git_commit"), "date": dig(d, "provenance", "date"),
     }
     for key, value in (params.items() if isinstance(params, dict) else []):
         row[f"param.{key}"] = value
     for prefix, path in (("full", "final_vs_full"), ("matched", "final"),
                          ("indirect", "indirect"), ("direct", "direct")):
-        _metric_columns(row, prefix, _at(d, "metrics", path))
+        _metric_columns(row, prefix, dig(d, "metrics", path))
     nonfinite = d.get("nonfinite")
     if isinstance(nonfinite, dict):
-        row["nan_pixels"] = sum(fnum(_at(c, "nan_pixels")) or 0 for c in nonfinite.values())
-        row["inf_pixels"] = sum(fnum(_at(c, "inf_pixels")) or 0 for c in nonfinite.values())
+        row["nan_pixels"] = sum(fnum(dig(c, "nan_pixels")) or 0 for c in nonfinite.values())
+        row["inf_pixels"] = sum(fnum(dig(c, "inf_pixels")) or 0 for c in nonfinite.values())
     if isinstance(d.get("animation"), dict):
-        row["animation_frames"] = _at(d, "animation", "frames")
-        row["update_kind"] = _at(d, "animation", "update")
-        row["dynamic_frame_gpu_ms_median"] = _at(d, "timing", "dynamic_frame_gpu_ms", "median")
-        row["dynamic_frame_gpu_ms_iqr"] = _at(d, "timing", "dynamic_frame_gpu_ms", "iqr")
-        row["dynamic_frame_cpu_ms_median"] = _at(d, "timing", "dynamic_frame_cpu_ms", "median")
-        seq = _at(d, "metrics", "sequence")
-        row["sequence.full.flip_mean"] = _at(seq, "full_flip_mean")
-        row["sequence.temporal.instability"] = _at(seq, "temporal", "temporal_instability")
-        row["sequence.temporal.noise_floor"] = _at(seq, "temporal", "noise_floor")
-        row["sequence.temporal_matched.instability"] = _at(seq, "temporal_matched",
+        row["animation_frames"] = dig(d, "animation", "frames")
+        row["update_kind"] = dig(d, "animation", "update")
+        row["dynamic_frame_gpu_ms_median"] = dig(d, "timing", "dynamic_frame_gpu_ms", "median")
+        row["dynamic_frame_gpu_ms_iqr"] = dig(d, "timing", "dynamic_frame_gpu_ms", "iqr")
+        row["dynamic_frame_cpu_ms_median"] = dig(d, "timing", "dynamic_frame_cpu_ms", "median")
+        seq = dig(d, "metrics", "sequence")
+        row["sequence.full.flip_mean"] = dig(seq, "full_flip_mean")
+        row["sequence.temporal.instability"] = dig(seq, "temporal", "temporal_instability")
+        row["sequence.temporal.noise_floor"] = dig(seq, "temporal", "noise_floor")
+        row["sequence.temporal_matched.instability"] = dig(seq, "temporal_matched",
                                                            "temporal_instability")
-        row["sequence.temporal_matched.noise_floor"] = _at(seq, "temporal_matched",
+        row["sequence.temporal_matched.noise_floor"] = dig(seq, "temporal_matched",
                                                            "noise_floor")
     return row
 
@@ -273,12 +269,16 @@ def add_leak_shares(rows: list[dict], runs: Iterable[Any]) -> None:
                 row["leak.share"] = seen / open_ref
 
 
-def load_rows(dirs: list[str]) -> list[dict]:
+def load_rows(dirs: list[str], unreadable: Optional[list[str]] = None) -> list[dict]:
     """Every committed run of the folders (report_data's reader: shards merged, in-progress
-    folders ignored) as rows; unreadable run folders are left out."""
+    folders ignored) as rows; an unreadable run folder is left out and, given `unreadable`,
+    added to it as 'path: why'."""
     from report_data import load_results
 
-    runs = load_results(dirs).runs
+    results = load_results(dirs)
+    if unreadable is not None:
+        unreadable += [f"{u.path}: {u.why}" for u in results.unreadable]
+    runs = results.runs
     rows = rows_from_runs(runs)
     add_leak_shares(rows, runs)
     return rows
@@ -453,19 +453,35 @@ class Column:
     limit: float
     cells: dict[str, Cell] = field(default_factory=dict)  # series -> cell
     winners: list[str] = field(default_factory=list)  # best first, then the ties
+    by_time: bool = False  # ranked by time (equal error) instead of by error (equal time)
+
+    def rank(self, cells: dict[str, Cell]) -> list[str]:
+        """Marks the best and the ties among `cells` by this column's measure."""
+        if self.by_time:
+            return _mark(cells, lambda p: p.x, time_tie)
+        return _mark(cells, lambda p: p.y, error_tie)
+
+
+def _columns(series_points: dict[str, list[Point]], limits: Iterable[float],
+             by_time: bool) -> list[Column]:
+    """One column per limit: each series' best ranked point within it (equal time: the lowest
+    error with time <= the budget; equal error: the least time with error <= the target)."""
+    out = []
+    for lim in limits:
+        label = f"HDR-FLIP ≤ {sig3(lim)}" if by_time else f"≤ {lim:g} ms"
+        col = Column(label=label, limit=lim, by_time=by_time)
+        for s, pts in series_points.items():
+            ok = [p for p in pts if p.ranked and (p.y if by_time else p.x) <= lim]
+            order = (lambda p: (p.x, p.y)) if by_time else (lambda p: (p.y, p.x))
+            col.cells[s] = Cell(min(ok, key=order) if ok else None)
+        col.winners = col.rank(col.cells)
+        out.append(col)
+    return out
 
 
 def equal_time(series_points: dict[str, list[Point]], budgets: Iterable[float]) -> list[Column]:
     """Per budget B: each series' lowest error among its ranked points with time <= B."""
-    out = []
-    for b in budgets:
-        col = Column(label=f"≤ {b:g} ms", limit=b)
-        for s, pts in series_points.items():
-            ok = [p for p in pts if p.ranked and p.x <= b]
-            col.cells[s] = Cell(min(ok, key=lambda p: (p.y, p.x)) if ok else None)
-        col.winners = _mark(col.cells, lambda p: p.y, error_tie)
-        out.append(col)
-    return out
+    return _columns(series_points, budgets, by_time=False)
 
 
 def error_targets(floor: Optional[float], fractions: Iterable[float]) -> list[float]:
@@ -479,15 +495,7 @@ def error_targets(floor: Optional[float], fractions: Iterable[float]) -> list[fl
 def equal_error(series_points: dict[str, list[Point]], targets: Iterable[float]
                 ) -> list[Column]:
     """Per target E: each series' least time among its ranked points with error <= E."""
-    out = []
-    for t in targets:
-        col = Column(label=f"HDR-FLIP ≤ {sig3(t)}", limit=t)
-        for s, pts in series_points.items():
-            ok = [p for p in pts if p.ranked and p.y <= t]
-            col.cells[s] = Cell(min(ok, key=lambda p: (p.x, p.y)) if ok else None)
-        col.winners = _mark(col.cells, lambda p: p.x, time_tie)
-        out.append(col)
-    return out
+    return _columns(series_points, targets, by_time=True)
 
 
 # ------------------------------------------------------------------------------------------------
@@ -827,9 +835,7 @@ def winners_words(col: Column) -> str:
 def restricted_winner(col: Column, excluded: str) -> Optional[str]:
     """The column's winner when `excluded` is not allowed (None: nothing else qualifies)."""
     cells = {s: Cell(c.point) for s, c in col.cells.items() if s != excluded}
-    key = (lambda p: p.x) if "FLIP" in col.label else (lambda p: p.y)
-    tie = time_tie if "FLIP" in col.label else error_tie
-    winners = _mark(cells, key, tie)
+    winners = col.rank(cells)
     return winners[0] if winners else None
 
 

@@ -288,6 +288,23 @@ def result_json(key: str, scene: str, tech: str, x, y, status="ok", params=None,
 
 
 class Findings(unittest.TestCase):
+    def test_an_unreadable_run_is_named_not_silently_dropped(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            run = os.path.join(tmp, "results", "study", "runs", "abc")
+            os.makedirs(run)
+            with open(os.path.join(run, "result.json"), "w") as f:
+                f.write('{"status": "ok", "scene": 3')  # truncated
+            out = os.path.join(tmp, "f.md")
+            p = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+                                os.path.join(tmp, "results", "study"), "--out", out],
+                               capture_output=True, text=True, timeout=120)
+            self.assertEqual(p.returncode, 0, p.stderr)
+            self.assertIn("left out an unreadable run", p.stderr)
+            self.assertIn("abc/result.json", p.stderr)
+            with open(out, encoding="utf-8") as f:
+                md = f.read()
+            self.assertIn("runs: 0 finished — none; 1 unreadable run folder(s) left out:", md)
+
     def test_writes_markdown_and_pngs(self):
         with tempfile.TemporaryDirectory() as tmp:
             results = os.path.join(tmp, "results", "study")
