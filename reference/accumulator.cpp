@@ -9,7 +9,7 @@
 
 namespace gilab::ref {
 
-void Accumulator::reset(int w, int h) {
+void Accumulator::reset(int w, int h, uint32_t replicateSamples) {
     if (w < 1 || h < 1)
         throw Error("reference accumulator: invalid size " + std::to_string(w) + "x" +
                     std::to_string(h));
@@ -20,6 +20,9 @@ void Accumulator::reset(int w, int h) {
     const size_t n = size_t(kLayerCount) * size_t(w) * size_t(h) * 3;
     sum.assign(n, 0.0);
     sumSq.assign(n, 0.0);
+    replicate = replicateSamples;
+    replicateSumSq.assign(replicate > 0 ? n : 0, 0.0);
+    replicateOpen.assign(replicate > 0 ? n : 0, 0.0);
 }
 
 double Accumulator::mean(Layer layer, int x, int y, int c) const {
@@ -31,6 +34,15 @@ double Accumulator::stdError(Layer layer, int x, int y, int c) const {
     if (samples < 2) return 0.0;
     const size_t i = index(layer, x, y, c);
     const double n = double(samples);
+    if (replicateErrors()) {
+        // Replicate sums S_r are i.i.d. (independent scrambles): their unbiased variance over
+        // the K finished ones, per sample (/ replicate), over all samples (/ n)
+        const double k = double(samples / replicate);
+        const double finished = sum[i] - replicateOpen[i];
+        const double varS =
+            std::max(0.0, (replicateSumSq[i] - finished * finished / k) / (k - 1.0));
+        return std::sqrt(varS / double(replicate) / n);
+    }
     const double m = sum[i] / n;
     // Unbiased sample variance from the running sums; clamped at 0 against rounding
     const double variance = std::max(0.0, (sumSq[i] - n * m * m) / (n - 1.0));

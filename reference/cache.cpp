@@ -29,6 +29,10 @@ static_assert(std::endian::native == std::endian::little, "accumulator.bin is li
 
 constexpr char kMagic[8] = {'G', 'I', 'L', 'A', 'B', 'A', 'C', 'C'};
 constexpr size_t kHeaderBytes = 48;
+/** Format 2 (an accumulator with Sobol replicates) adds the replicate size to the header, and
+ *  the arrays replicateSumSq and replicateOpen after sumSq. Format 1 has neither. */
+constexpr uint32_t kReplicateFormatVersion = 2;
+constexpr size_t kReplicateHeaderBytes = 56;
 constexpr size_t kChecksumBytes = 16;
 
 struct Header {
@@ -39,6 +43,7 @@ struct Header {
     uint64_t samples = 0;
     uint64_t nonFiniteSamples = 0;
     uint64_t valueCount = 0;  // per array (sum, sumSq)
+    uint64_t replicate = 0;   // format 2
 };
 
 using FilePtr = std::unique_ptr<FILE, int (*)(FILE*)>;
@@ -96,7 +101,9 @@ bool exchangePaths(const fs::path& a, const fs::path& b) {
 
 void writeAccumulatorFile(const fs::path& path, const Accumulator& acc) {
     const uint64_t n = uint64_t(kLayerCount) * uint64_t(acc.width) * uint64_t(acc.height) * 3;
-    if (acc.width <= 0 || acc.height <= 0 || acc.sum.size() != n || acc.sumSq.size() != n)
+    const uint64_t replicateValues = acc.replicate > 0 ? n : 0;
+    if (acc.width <= 0 || acc.height <= 0 || acc.sum.size() != n || acc.sumSq.size() != n ||
+        acc.replicateSumSq.size() != replicateValues || acc.replicateOpen.size() != replicateValues)
         throw Error(path.string() + ": accumulator has inconsistent sizes, not written");
     FilePtr f(std::fopen(path.c_str(), "wb"), std::fclose);
     if (!f) throw Error(path.string() + ": cannot create: " + errnoText());
@@ -109,14 +116,20 @@ void writeAccumulatorFile(const fs::path& path, const Accumulator& acc) {
         XXH3_128bits_update(state.get(), data, bytes);
         ok = ok && std::fwrite(data, 1, bytes, f.get()) == bytes;
     };
-    const uint32_t header32[4] = {kAccumulatorFormatVersion, uint32_t(kLayerCount),
-                                  uint32_t(acc.width), uint32_t(acc.height)};
-    const uint64_t header64[3] = {acc.samples, acc.nonFiniteSamples, n};
+    const uint32_t version =
+        acc.replicate > 0 ? kReplicateFormatVersion : kAccumulatorFormatVersion;
+    const uint32_t header32[4] = {version, uint32_t(kLayerCount), uint32_t(acc.width),
+                                  uint32_t(acc.height)};
+    const uint64_t header64[4] = {acc.samples, acc.nonFiniteSamples, n, acc.replicate};
     put(kMagic, sizeof kMagic);
     put(header32, sizeof header32);
-    put(header64, sizeof header64);
+    put(header64, acc.replicate > 0 ? 4 * sizeof(uint64_t) : 3 * sizeof(uint64_t));
     put(acc.sum.data(), n * sizeof(double));
     put(acc.sumSq.data(), n * sizeof(double));
+    if (acc.replicate > 0) {
+        put(acc.replicateSumSq.data(), n * sizeof(double));
+        put(acc.replicateOpen.data(), n * sizeof(double));
+    }
     XXH128_canonical_t digest;
     XXH128_canonicalFromHash(&digest, XXH3_128bits_digest(state.get()));
     ok = ok && std::fwrite(digest.digest, 1, sizeof digest.digest, f.get()) == kChecksumBytes;
@@ -133,28 +146,41 @@ Accumulator readAccumulatorFile(const fs::path& path) {
     if (ec || fileBytes < kHeaderBytes + kChecksumBytes)
         throw Error(where + "truncated (" + std::to_string(fileBytes) + " bytes)");
 
-    unsigned char raw[kHeaderBytes];
+    unsigned char raw[kReplicateHeaderBytes];
     if (std::fread(raw, 1, kHeaderBytes, f.get()) != kHeaderBytes)
         throw Error(where + "cannot read the header");
     if (std::memcmp(raw, kMagic, sizeof kMagic) != 0) throw Error(where + "bad magic");
     Header h;
     std::memcpy(&h.version, raw + 8, 4);
+    size_t headerBytes = kHeaderBytes;
+    if (h.version == kReplicateFormatVersion) {
+        headerBytes = kReplicateHeaderBytes;
+        if (fileBytes < headerBytes + kChecksumBytes ||
+            std::fread(raw + kHeaderBytes, 1, headerBytes - kHeaderBytes, f.get()) !=
+                headerBytes - kHeaderBytes)
+            throw Error(where + "cannot read the header");
+        std::memcpy(&h.replicate, raw + 48, 8);
+        if (h.replicate < 1 || h.replicate > (1u << 30) || !std::has_single_bit(h.replicate))
+            throw Error(where + "bad replicate size " + std::to_string(h.replicate));
+    }
     std::memcpy(&h.layerCount, raw + 12, 4);
     std::memcpy(&h.width, raw + 16, 4);
     std::memcpy(&h.height, raw + 20, 4);
     std::memcpy(&h.samples, raw + 24, 8);
     std::memcpy(&h.nonFiniteSamples, raw + 32, 8);
     std::memcpy(&h.valueCount, raw + 40, 8);
-    if (h.version != kAccumulatorFormatVersion)
+    if (h.version != kAccumulatorFormatVersion && h.version != kReplicateFormatVersion)
         throw Error(where + "format version " + std::to_string(h.version) + ", expected " +
-                    std::to_string(kAccumulatorFormatVersion));
+                    std::to_string(kAccumulatorFormatVersion) + " or " +
+                    std::to_string(kReplicateFormatVersion));
     if (h.layerCount != uint32_t(kLayerCount))
         throw Error(where + std::to_string(h.layerCount) + " layers, expected " +
                     std::to_string(kLayerCount));
     if (h.width < 1 || h.height < 1 || h.width > 16384 || h.height > 16384 ||
         h.valueCount != uint64_t(kLayerCount) * h.width * h.height * 3)
         throw Error(where + "bad size " + std::to_string(h.width) + "x" + std::to_string(h.height));
-    const uint64_t expected = kHeaderBytes + 2 * h.valueCount * sizeof(double) + kChecksumBytes;
+    const uint64_t arrays = h.replicate > 0 ? 4 : 2;
+    const uint64_t expected = headerBytes + arrays * h.valueCount * sizeof(double) + kChecksumBytes;
     if (fileBytes != expected)
         throw Error(where + std::to_string(fileBytes) + " bytes, expected " +
                     std::to_string(expected) + " (truncated or extended)");
@@ -164,21 +190,25 @@ Accumulator readAccumulatorFile(const fs::path& path) {
     acc.height = int(h.height);
     acc.samples = h.samples;
     acc.nonFiniteSamples = h.nonFiniteSamples;
-    acc.sum.resize(h.valueCount);
-    acc.sumSq.resize(h.valueCount);
+    acc.replicate = uint32_t(h.replicate);
+    std::vector<double>* values[4] = {&acc.sum, &acc.sumSq, &acc.replicateSumSq,
+                                      &acc.replicateOpen};
     const size_t bytes = h.valueCount * sizeof(double);
+    for (uint64_t a = 0; a < arrays; ++a) {
+        values[a]->resize(h.valueCount);
+        if (std::fread(values[a]->data(), 1, bytes, f.get()) != bytes)
+            throw Error(where + "short read");
+    }
     unsigned char stored[kChecksumBytes];
-    if (std::fread(acc.sum.data(), 1, bytes, f.get()) != bytes ||
-        std::fread(acc.sumSq.data(), 1, bytes, f.get()) != bytes ||
-        std::fread(stored, 1, kChecksumBytes, f.get()) != kChecksumBytes)
+    if (std::fread(stored, 1, kChecksumBytes, f.get()) != kChecksumBytes)
         throw Error(where + "short read");
 
     std::unique_ptr<XXH3_state_t, XXH_errorcode (*)(XXH3_state_t*)> state(XXH3_createState(),
                                                                           XXH3_freeState);
     XXH3_128bits_reset(state.get());
-    XXH3_128bits_update(state.get(), raw, kHeaderBytes);
-    XXH3_128bits_update(state.get(), acc.sum.data(), bytes);
-    XXH3_128bits_update(state.get(), acc.sumSq.data(), bytes);
+    XXH3_128bits_update(state.get(), raw, headerBytes);
+    for (uint64_t a = 0; a < arrays; ++a)
+        XXH3_128bits_update(state.get(), values[a]->data(), bytes);
     XXH128_canonical_t digest;
     XXH128_canonicalFromHash(&digest, XXH3_128bits_digest(state.get()));
     if (std::memcmp(digest.digest, stored, kChecksumBytes) != 0)
@@ -332,6 +362,7 @@ nlohmann::ordered_json settingsJson(const ReferenceSettings& settings) {
             {"seed", settings.seed},
             {"pixel_filter", pixelFilterName(settings.pixelFilter)},
             {"sampler", samplerKindName(settings.sampler)},
+            {"sobol_replicate", settings.sobolReplicate},
             {"batch_samples", settings.batchSamples}};
 }
 
@@ -392,6 +423,7 @@ nlohmann::ordered_json makeSidecar(const ReferenceKey& key, const ReferenceSetti
     history.push_back({{"from_samples", r.continuedFromSamples},
                        {"to_samples", r.acc.samples},
                        {"seconds", r.report.seconds},
+                       {"cpu_seconds", r.report.cpuSeconds},
                        {"stop_reason", stopReasonName(r.reason)},
                        {"nonfinite_samples", r.report.rays.nonFiniteSamples},
                        {"threads", threads},
@@ -402,6 +434,7 @@ nlohmann::ordered_json makeSidecar(const ReferenceKey& key, const ReferenceSetti
     s["key"] = key.hex;
     s["samples"] = r.acc.samples;
     s["seconds"] = previous.value("seconds", 0.0) + r.report.seconds;
+    s["cpu_seconds"] = previous.value("cpu_seconds", 0.0) + r.report.cpuSeconds;
     s["rel_error"] = meanRelativeStdError(r.acc);
     s["stop_reason"] = stopReasonName(r.reason);
     s["nonfinite_samples"] = r.acc.nonFiniteSamples;  // dropped (added 0), over all pixels

@@ -4,7 +4,8 @@
  * holding the raw accumulator, the mean + standard-error EXR and a JSON sidecar, written
  * atomically; and obtainReference(), which reuses, continues or renders a reference.
  *
- *   <cache>/<key>/accumulator.bin   header, sum and sumSq (double), XXH3-128 checksum
+ *   <cache>/<key>/accumulator.bin   header, sum and sumSq (double; with Sobol replicates also
+ *                                   replicateSumSq and replicateOpen), XXH3-128 checksum
  *   <cache>/<key>/reference.exr     layers "full", ..., "full_stderr", ... (float32)
  *   <cache>/<key>/reference.json    status "complete" | "partial", samples, provenance, ...
  */

@@ -230,6 +230,14 @@ void EmbreeScene::intersect16(int count, const glm::vec3* o, const glm::vec3* d,
     }
 }
 
+void EmbreeScene::intersectStream(std::vector<RTCRayHit>& rays) const {
+    if (rays.empty()) return;
+    RTCIntersectContext context;
+    rtcInitIntersectContext(&context);
+    context.flags = RTC_INTERSECT_CONTEXT_FLAG_INCOHERENT;
+    rtcIntersect1M(m_scene, &context, rays.data(), unsigned(rays.size()), sizeof(RTCRayHit));
+}
+
 void EmbreeScene::occludedStream(std::vector<RTCRay>& rays) const {
     if (rays.empty()) return;
     RTCIntersectContext context;

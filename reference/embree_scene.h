@@ -80,6 +80,8 @@ public:
     /** Occlusion of every ray in one rtcOccluded1M stream call (Embree regroups the rays);
      *  an occluded ray gets tfar = -inf. */
     void occludedStream(std::vector<RTCRay>& rays) const;
+    /** rtcIntersect1M over `rays` (incoherent): the closest hits, in place. */
+    void intersectStream(std::vector<RTCRayHit>& rays) const;
 
     /** Throws gilab::Error with Embree's message if the device reports an error. */
     void checkError(const char* what) const;

@@ -202,11 +202,47 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
 }
 
 void Integrator::traceClosest(std::vector<PathState>& paths, const std::vector<uint32_t>& active,
-                              bool packets, bool coherent) const {
+                              bool packets, bool coherent, std::vector<RTCRayHit>& stream) const {
     if (!packets) {
         for (uint32_t i : active) {
             PathState& p = paths[i];
             p.found = m_mesh.intersect(p.rayO, p.rayD, 0.0f, kInfinity, p.hit);
+        }
+        return;
+    }
+    if (!coherent) {
+        // Bounce rays: one rtcIntersect1M stream (the same hits as 16-wide packets, bit for bit;
+        // 2-3 % faster on Sponza, the same on the Cornell box: docs/reference.md "Throughput")
+        stream.resize(active.size());
+        for (size_t j = 0; j < active.size(); ++j) {
+            const PathState& p = paths[active[j]];
+            RTCRayHit& r = stream[j];
+            r.ray.org_x = p.rayO.x;
+            r.ray.org_y = p.rayO.y;
+            r.ray.org_z = p.rayO.z;
+            r.ray.tnear = 0.0f;
+            r.ray.dir_x = p.rayD.x;
+            r.ray.dir_y = p.rayD.y;
+            r.ray.dir_z = p.rayD.z;
+            r.ray.time = 0.0f;
+            r.ray.tfar = kInfinity;
+            r.ray.mask = ~0u;
+            r.ray.id = unsigned(j);
+            r.ray.flags = 0;
+            r.hit.geomID = RTC_INVALID_GEOMETRY_ID;
+            r.hit.primID = RTC_INVALID_GEOMETRY_ID;
+            r.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
+        }
+        m_mesh.intersectStream(stream);
+        for (size_t j = 0; j < active.size(); ++j) {
+            PathState& p = paths[active[j]];
+            const RTCRayHit& r = stream[j];
+            p.found = r.hit.geomID != RTC_INVALID_GEOMETRY_ID;
+            p.hit.prim = p.found ? r.hit.primID : ~0u;
+            if (!p.found) continue;
+            p.hit.t = r.ray.tfar;
+            p.hit.u = r.hit.u;
+            p.hit.v = r.hit.v;
         }
         return;
     }
@@ -289,7 +325,7 @@ void Integrator::tracePaths(std::vector<PathState>& paths, PathRadiance* out, bo
     for (bool cameraRays = true; !active.empty(); cameraRays = false) {
         // 1. The closest hits of every live path's ray (camera rays are coherent)
         if (!(cameraRays && cameraHitsKnown)) {
-            traceClosest(paths, active, packets, cameraRays);
+            traceClosest(paths, active, packets, cameraRays, scratch.bounceRays);
             (cameraRays ? counters.cameraRays : counters.bounceRays) += active.size();
             if (sink)
                 for (uint32_t i : active)

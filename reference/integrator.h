@@ -12,7 +12,8 @@
  * maxBounces = B: light arriving at vertices k <= B + 1 only.
  *
  * Paths are traced as a wavefront (docs/reference.md, "Wavefront"): all live paths' rays of one
- * depth go to Embree in 16-wide packets, then every hit is shaded (queuing its shadow rays),
+ * depth go to Embree (camera rays in 16-wide packets, bounce rays in one rtcIntersect1M
+ * stream), then every hit is shaded (queuing its shadow rays),
  * then all shadow rays are traced in one rtcOccluded1M stream and the unoccluded ones add their
  * light. Each path's arithmetic and random numbers are those of tracing it alone, in the same
  * order.
@@ -74,7 +75,8 @@ struct ShadowRay {
 struct WaveScratch {
     std::vector<uint32_t> active, next;
     std::vector<ShadowRay> shadows;
-    std::vector<RTCRay> shadowRays;  // the stream handed to rtcOccluded1M
+    std::vector<RTCRay> shadowRays;     // the stream handed to rtcOccluded1M
+    std::vector<RTCRayHit> bounceRays;  // the stream handed to rtcIntersect1M
 };
 
 class Integrator {
@@ -103,7 +105,7 @@ private:
     void prefetchTexels(const PathState& p) const;
 
     void traceClosest(std::vector<PathState>& paths, const std::vector<uint32_t>& active,
-                      bool packets, bool coherent) const;
+                      bool packets, bool coherent, std::vector<RTCRayHit>& stream) const;
     void traceShadows(const std::vector<ShadowRay>& shadows, std::vector<RTCRay>& stream,
                       PathRadiance* out, bool packets) const;
 

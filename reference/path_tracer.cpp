@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <limits>
 #include <sstream>
@@ -70,9 +71,15 @@ TextureFootprint rasterFootprint(const PrimaryRays& rays, const MeshTriangle& tr
     return fp;
 }
 
+/** Whether a triangle's material has any texture (the footprint matters only then). */
+bool hasTextures(const Scene& scene, const MeshTriangle& tri) {
+    const Material& m = scene.materials[tri.material];
+    return m.baseColorTexture >= 0 || m.metallicRoughnessTexture >= 0 || m.emissiveTexture >= 0;
+}
+
 constexpr int kTileSize = 8;
-constexpr int kPacketSize = 4;   // camera rays of a 4 x 4 pixel block share one rtcIntersect16
-constexpr int kWaveSamples = 4;  // samples per pixel traced together as one wavefront
+constexpr int kPacketSize = 4;    // camera rays of a 4 x 4 pixel block share one rtcIntersect16
+constexpr int kWaveSamples = 16;  // samples per pixel traced together as one wavefront
 constexpr int kValuesPerPixel = kLayerCount * 3;
 
 std::atomic<bool> g_rayPackets{true};
@@ -83,6 +90,9 @@ void validate(const Scene& scene, const ReferenceSettings& s) {
     if (!(s.rouletteThreshold > 0.0f && s.rouletteThreshold <= 1.0f))
         throw Error("reference: roulette_threshold must be in (0, 1]");
     if (s.batchSamples < 1) throw Error("reference: batchSamples must be >= 1");
+    if (s.sobolReplicate < 1 || !std::has_single_bit(s.sobolReplicate))
+        throw Error("reference: sobol_replicate must be a power of two (got " +
+                    std::to_string(s.sobolReplicate) + ")");
     if (scene.settings.width < 1 || scene.settings.height < 1)
         throw Error("scene '" + scene.name + "': invalid resolution");
     const int texCount = int(scene.textures.size());
@@ -148,11 +158,12 @@ struct PathTracer::Impl {
           lights(scene, textures, mesh),
           integrator(scene, settings, mesh, lights, textures) {}
 
-    /** Renders samples [first, first + count) of one tile into `sum`/`sumSq` (which hold the
+    /** Renders samples [first, first + count) of one tile into `out` (the accumulator's arrays
+     *  sum, sumSq and, with replicates, replicateSumSq and replicateOpen; they hold the
      *  accumulator's values of those pixels on entry). */
     void renderTile(int tx, int ty, uint64_t first, uint32_t count, const Accumulator& acc,
-                    std::vector<double>& outSum, std::vector<double>& outSumSq,
-                    PathCounters& counters, uint64_t& nonFinite, bool packets);
+                    std::vector<double>* const* out, PathCounters& counters, uint64_t& nonFinite,
+                    bool packets);
 
     const Scene scene;  // a copy: the tracer never depends on the caller's lifetime
     const ReferenceSettings settings;
@@ -170,44 +181,59 @@ struct PathTracer::Impl {
         WaveScratch wave;
     };
     tbb::enumerable_thread_specific<TileScratch> scratch;
-    std::vector<double> scratchSum, scratchSumSq;
+    /** The next accumulator arrays (sum, sumSq, replicateSumSq, replicateOpen), swapped in
+     *  when a call completes. */
+    std::vector<double> scratch4[4];
 };
 
 void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count,
-                                  const Accumulator& acc, std::vector<double>& outSum,
-                                  std::vector<double>& outSumSq, PathCounters& counters,
-                                  uint64_t& nonFinite, bool packets) {
+                                  const Accumulator& acc, std::vector<double>* const* out,
+                                  PathCounters& counters, uint64_t& nonFinite, bool packets) {
     const int w = acc.width, h = acc.height;
     const int x0 = tx * kTileSize, y0 = ty * kTileSize;
     const int x1 = std::min(x0 + kTileSize, w), y1 = std::min(y0 + kTileSize, h);
     const int tw = x1 - x0;
     const int pixels = tw * (y1 - y0);
 
-    // The tile's running sums, starting from the accumulator's (per pixel: layer, channel)
-    double sum[kTileSize * kTileSize][kValuesPerPixel];
-    double sumSq[kTileSize * kTileSize][kValuesPerPixel];
+    // The tile's running sums, starting from the accumulator's (per pixel: layer, channel):
+    // sum, sumSq and, with replicates, the finished replicates' squared sums and the open one's
+    const uint32_t replicate = acc.replicate;
+    const int arrays = replicate > 0 ? 4 : 2;
+    const std::vector<double>* in[4] = {&acc.sum, &acc.sumSq, &acc.replicateSumSq,
+                                        &acc.replicateOpen};
+    using TileValues = double[kTileSize * kTileSize][kValuesPerPixel];
+    TileValues tileSums[4];
+    TileValues& sum = tileSums[0];
+    TileValues& sumSq = tileSums[1];
+    TileValues& repSq = tileSums[2];
+    TileValues& repOpen = tileSums[3];
     for (int p = 0; p < pixels; ++p) {
         const int x = x0 + p % tw, y = y0 + p / tw;
         for (int l = 0; l < kLayerCount; ++l)
             for (int c = 0; c < 3; ++c) {
                 const size_t i = acc.index(Layer(l), x, y, c);
-                sum[p][l * 3 + c] = acc.sum[i];
-                sumSq[p][l * 3 + c] = acc.sumSq[i];
+                for (int a = 0; a < arrays; ++a)
+                    tileSums[a][p][l * 3 + c] = (*in[a])[i];
             }
     }
 
-    // Adds one sample in sample order; a sample with a NaN/Inf in any layer adds nothing
-    auto add = [&](int p, const PathRadiance& r) {
+    // Adds sample s of tile pixel p, in sample order; a sample with a NaN/Inf in any layer adds
+    // nothing. The last sample of a replicate closes it: its sum's square is added.
+    auto add = [&](int p, uint64_t s, const PathRadiance& r) {
+        bool finite = true;
         for (int l = 0; l < kLayerCount; ++l)
-            if (!isFinite(r.L[l])) {
-                ++nonFinite;
-                return;
-            }
-        for (int l = 0; l < kLayerCount; ++l)
-            for (int c = 0; c < 3; ++c) {
-                const double v = double(r.L[l][c]);
-                sum[p][l * 3 + c] += v;
-                sumSq[p][l * 3 + c] += v * v;
+            finite = finite && isFinite(r.L[l]);
+        if (!finite) ++nonFinite;
+        for (int v = 0; finite && v < kValuesPerPixel; ++v) {
+            const double x = double(r.L[v / 3][v % 3]);
+            sum[p][v] += x;
+            sumSq[p][v] += x * x;
+            if (replicate > 0) repOpen[p][v] += x;
+        }
+        if (replicate > 0 && ((s + 1) & (replicate - 1)) == 0)  // a power of two
+            for (int v = 0; v < kValuesPerPixel; ++v) {
+                repSq[p][v] += repOpen[p][v] * repOpen[p][v];
+                repOpen[p][v] = 0.0;
             }
     };
 
@@ -221,6 +247,7 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
     // Centre filter: the camera rays are traced here, a 4 x 4 block per packet, so each hit
     // gets the rasteriser's texture footprint before it is shaded
     const bool center = settings.pixelFilter == PixelFilter::Center;
+    const uint32_t replicateLog2 = uint32_t(std::countr_zero(settings.sobolReplicate));
     auto traceCameraRays = [&]() {
         for (size_t first = 0; first < paths.size(); first += 16) {
             const int n = int(std::min<size_t>(16, paths.size() - first));
@@ -242,8 +269,10 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
                 PathState& path = paths[first + size_t(i)];
                 path.hit = hits[i];
                 path.found = hits[i].prim != ~0u;
-                path.hasFootprint = path.found;
-                if (path.found) {
+                // Only textured materials look anything up with the footprint (measured 3.6 % of
+                // the time on the untextured Cornell box, docs/reference.md "Throughput")
+                path.hasFootprint = path.found && hasTextures(scene, mesh.triangle(hits[i].prim));
+                if (path.hasFootprint) {
                     const int tilePixel = pathPixel[first + size_t(i)];
                     path.footprint = rasterFootprint(cameraRay, mesh.triangle(hits[i].prim),
                                                      x0 + tilePixel % tw, y0 + tilePixel / tw);
@@ -266,7 +295,8 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
                         for (int x = bx; x < std::min(bx + kPacketSize, x1); ++x) {
                             const uint64_t pixelIndex = uint64_t(y) * uint64_t(w) + uint64_t(x);
                             PathState& path = paths.emplace_back();
-                            path.sampler = Sampler(settings.seed, pixelIndex, s, settings.sampler);
+                            path.sampler = Sampler(settings.seed, pixelIndex, s, settings.sampler,
+                                                   replicateLog2);
                             const glm::vec2 u = pixelOffset(path.sampler, settings.pixelFilter);
                             const Ray ray = cameraRay(float(x) + u.x, float(y) + u.y);
                             path.rayO = ray.origin;
@@ -277,8 +307,8 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
         if (center) traceCameraRays();
         ws.radiance.resize(paths.size());
         integrator.tracePaths(paths, ws.radiance.data(), center, packets, counters, sink, ws.wave);
-        for (size_t i = 0; i < paths.size(); ++i)
-            add(pathPixel[i], ws.radiance[i]);
+        for (size_t i = 0; i < paths.size(); ++i)  // paths: sample-major, then tile pixels
+            add(pathPixel[i], s0 + i / size_t(pixels), ws.radiance[i]);
     }
 
     for (int p = 0; p < pixels; ++p) {
@@ -286,8 +316,8 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
         for (int l = 0; l < kLayerCount; ++l)
             for (int c = 0; c < 3; ++c) {
                 const size_t i = acc.index(Layer(l), x, y, c);
-                outSum[i] = sum[p][l * 3 + c];
-                outSumSq[i] = sumSq[p][l * 3 + c];
+                for (int a = 0; a < arrays; ++a)
+                    (*out[a])[i] = tileSums[a][p][l * 3 + c];
             }
     }
 }
@@ -305,12 +335,27 @@ bool PathTracer::addSamples(Accumulator& acc, uint32_t count, const std::atomic<
         throw Error("reference: the accumulator is " + std::to_string(acc.width) + "x" +
                     std::to_string(acc.height) + ", the scene " + std::to_string(w) + "x" +
                     std::to_string(h) + " (reset it first)");
+    // Sobol samples come in independently scrambled replicates: a fresh accumulator keeps
+    // their sums (the error bars); one made with other replicates cannot be continued
+    const uint32_t replicate =
+        im.settings.sampler == SamplerKind::Sobol ? im.settings.sobolReplicate : 0;
+    if (acc.replicate != replicate) {
+        if (acc.samples != 0)
+            throw Error("reference: the accumulator's samples come in replicates of " +
+                        std::to_string(acc.replicate) + ", these settings make " +
+                        std::to_string(replicate) + " (0 = independent samples)");
+        acc.reset(w, h, replicate);
+    }
     if (count == 0) return true;
     const Stopwatch watch;
 
     // Render into scratch sums (initialised from acc per tile); commit only if not cancelled
-    im.scratchSum.resize(n);
-    im.scratchSumSq.resize(n);
+    const int arrays = replicate > 0 ? 4 : 2;
+    std::vector<double>* out[4];
+    for (int a = 0; a < 4; ++a) {
+        im.scratch4[a].resize(a < arrays ? n : 0);
+        out[a] = &im.scratch4[a];
+    }
     const int tilesX = (w + kTileSize - 1) / kTileSize, tilesY = (h + kTileSize - 1) / kTileSize;
     const int tileCount = tilesX * tilesY;
     const uint64_t first = acc.samples;
@@ -325,8 +370,8 @@ bool PathTracer::addSamples(Accumulator& acc, uint32_t count, const std::atomic<
         }
         PathCounters counters;
         uint64_t tileNonFinite = 0;
-        im.renderTile(t % tilesX, t / tilesX, first, count, acc, im.scratchSum, im.scratchSumSq,
-                      counters, tileNonFinite, packets);
+        im.renderTile(t % tilesX, t / tilesX, first, count, acc, out, counters, tileNonFinite,
+                      packets);
         cameraRays += counters.cameraRays;
         bounceRays += counters.bounceRays;
         shadowRays += counters.shadowRays;
@@ -345,8 +390,10 @@ bool PathTracer::addSamples(Accumulator& acc, uint32_t count, const std::atomic<
     im.stats.seconds += watch.elapsedMs() * 1e-3;
     im.mesh.checkError("tracing rays");
     if (cancelled) return false;
-    acc.sum.swap(im.scratchSum);
-    acc.sumSq.swap(im.scratchSumSq);
+    acc.sum.swap(im.scratch4[0]);
+    acc.sumSq.swap(im.scratch4[1]);
+    acc.replicateSumSq.swap(im.scratch4[2]);
+    acc.replicateOpen.swap(im.scratch4[3]);
     acc.samples += count;
     acc.nonFiniteSamples += nonFinite;
     im.stats.nonFiniteSamples += nonFinite;
@@ -392,8 +439,11 @@ std::string PathTracer::toString() const {
            "min(1, scene magnitude)\n"
         << (s.sampler == SamplerKind::Independent
                 ? "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
-                : "rng: sobol, Owen-scrambled (0,2)-sequence per 1D/2D draw, shuffled index "
-                  "(Burley 2020), seeds from SplitMix64 of (seed, pixel, draw)\n")
+                : "rng: sobol, Owen-scrambled (0,2)-sequence per 1D/2D draw of the first 6, "
+                  "shuffled index (Burley 2020), seeds from SplitMix64 of (seed, pixel, "
+                  "replicate, draw); replicates of " +
+                      std::to_string(s.sobolReplicate) +
+                      " samples (error bars from their spread)\n")
         << "punctual_lights: " << im.lights.punctualCount() << ", all evaluated at every vertex\n"
         << "emissive_triangles: " << im.lights.emitterCount()
         << ", one sample per vertex by luminance power, uniform on the triangle\n"

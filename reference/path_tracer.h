@@ -70,14 +70,24 @@ struct ReferenceSettings {
     PixelFilter pixelFilter = PixelFilter::Center;
     /** Independent uniforms (default) or Owen-scrambled Sobol (docs/reference.md, "Samplers"). */
     SamplerKind sampler = SamplerKind::Independent;
-    /** Samples added per pass over the image; the stop criteria are checked between passes. */
-    uint32_t batchSamples = 4;
+    /** Sobol only: samples per independently scrambled replicate (a power of two); the spread of
+     *  the replicates gives the per-pixel error bars (docs/reference.md, "Samplers"). */
+    uint32_t sobolReplicate = 64;
+    /** Samples added per pass over the image; the stop criteria are checked between passes. Up
+     *  to 16 samples of a tile's pixels are traced as one wavefront (docs/reference.md). */
+    uint32_t batchSamples = 16;
 };
 
 /**
  * Running sums per layer, pixel and channel (double), enough to continue a render and to
  * estimate the per-pixel variance of every layer. Index: ((layer * height + y) * width + x) * 3 +
  * c.
+ *
+ * With the Sobol sampler the samples of a pixel are not independent, so the sample variance
+ * over-estimates the error. Its samples come in replicates of `replicate` samples, each an
+ * independently scrambled sequence (Sampler); the accumulator then also keeps, per value, the
+ * sum of squares of the finished replicates' sums and the open replicate's running sum, and the
+ * error is estimated from the spread of the replicates (docs/reference.md, "Samplers").
  */
 struct Accumulator {
     int width = 0;
@@ -88,15 +98,28 @@ struct Accumulator {
     uint64_t nonFiniteSamples = 0;
     std::vector<double> sum;
     std::vector<double> sumSq;
+    /** Samples per replicate (a power of two), 0 = independent samples: no replicate sums. */
+    uint32_t replicate = 0;
+    std::vector<double> replicateSumSq;  // sum over finished replicates of (replicate sum)^2
+    std::vector<double> replicateOpen;   // the unfinished replicate's sum so far
 
-    void reset(int w, int h);
+    /** Errors come from the replicates' spread once this many have finished; before, from the
+     *  sample variance (conservative for Sobol). */
+    static constexpr uint64_t kMinReplicates = 8;
+
+    /** Zero sums of w x h pixels; replicate > 0 also keeps the replicate sums. */
+    void reset(int w, int h, uint32_t replicate = 0);
     size_t index(Layer layer, int x, int y, int c) const {
         return ((size_t(layer) * size_t(height) + size_t(y)) * size_t(width) + size_t(x)) * 3 +
                size_t(c);
     }
     double mean(Layer layer, int x, int y, int c) const;
-    /** Standard error of the mean: sqrt(sample variance / samples); 0 with < 2 samples. */
+    /** Standard error of the mean, 0 with < 2 samples: sqrt(sample variance / samples), or with
+     *  >= kMinReplicates finished replicates sqrt(variance of a replicate's sum / replicate /
+     *  samples). */
     double stdError(Layer layer, int x, int y, int c) const;
+    /** Whether stdError uses the replicates' spread. */
+    bool replicateErrors() const { return replicate > 0 && samples / replicate >= kMinReplicates; }
 };
 
 /** The mean (or standard-error) image of one layer, RGB. */
@@ -187,6 +210,7 @@ struct RenderReport {
     StopReason reason = StopReason::Samples;
     uint64_t samples = 0;
     double seconds = 0.0;
+    double cpuSeconds = 0.0;  // CPU time of the process meanwhile (every thread)
     double relError = 0.0;
     RayStats rays;
     std::vector<ConvergencePoint> curve;  // one point per batch

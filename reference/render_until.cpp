@@ -53,6 +53,7 @@ RenderReport renderUntil(PathTracer& tracer, Accumulator& acc, const StopCriteri
     const RayStats before = tracer.stats();
     const uint64_t startSamples = acc.samples;
     const Stopwatch watch;
+    const double cpuStart = processCpuSeconds();
     Progress progress("reference " + tracer.scene().name);
     report.relError = meanRelativeStdError(acc, Layer::Full);
 
@@ -112,6 +113,7 @@ RenderReport renderUntil(PathTracer& tracer, Accumulator& acc, const StopCriteri
     report.reason = reason;
     report.samples = acc.samples;
     report.seconds = watch.elapsedMs() * 1e-3;
+    report.cpuSeconds = processCpuSeconds() - cpuStart;
     report.rays = difference(tracer.stats(), before);
     char detail[160];
     std::snprintf(detail, sizeof detail, "%llu spp, rel err %.4g, stopped: %s",

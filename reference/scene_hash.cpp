@@ -204,6 +204,7 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
     h.u64(settings.seed);
     h.i32(int32_t(settings.pixelFilter));
     h.i32(int32_t(settings.sampler));
+    if (settings.sampler == SamplerKind::Sobol) h.u64(settings.sobolReplicate);
     h.tag("scene_data");
     h.str(dataHash);
 
@@ -231,7 +232,8 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
           {"estimator", estimatorName(settings.estimator)},
           {"seed", settings.seed},
           {"pixel_filter", pixelFilterName(settings.pixelFilter)},
-          {"sampler", samplerKindName(settings.sampler)}}},
+          {"sampler", samplerKindName(settings.sampler)},
+          {"sobol_replicate", settings.sobolReplicate}}},
         {"scene_data_xxh3_128", dataHash},
         {"scene_data",
          {{"vertices", scene.vertices.size()},

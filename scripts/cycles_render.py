@@ -1,15 +1,19 @@
 # Blender-side half of scripts/cycles_crosscheck.sh (optional; not part of the build or CI).
 #
 # Renders a glTF scene with Cycles the way gilab's reference path tracer sees it: every
-# material becomes Diffuse(baseColorFactor) + Emission(emissiveFactor x emissiveStrength),
-# read from the glTF JSON itself; gilab's camera (a scene description's "camera", in glTF
-# Y-up coordinates); rays through pixel centres, no adaptive sampling, denoising or clamping;
-# black world. Writes a linear 32-bit float RGB OpenEXR and, beside it, a JSON with the render
-# time. The figures the cross-check derives from it belong in docs/reference.md ("Measured").
+# material becomes Diffuse(base colour) + Emission(emissiveFactor x emissiveStrength), read
+# from the glTF JSON itself; the base colour is baseColorFactor, or with --textures whatever the
+# glTF importer linked to its Principled BSDF's Base Color (the texture times the factor);
+# gilab's camera and directional lights (a scene description's "camera" and "lights", in glTF
+# Y-up coordinates; a directional light becomes a sun of angle 0 and strength colour x
+# intensity, W/m^2 as docs/conventions.md); rays through pixel centres, no adaptive sampling,
+# denoising or clamping; black world. Writes a linear 32-bit float RGB OpenEXR and, beside it, a
+# JSON with the render's wall and CPU time. The figures the cross-check derives from it belong
+# in docs/reference.md ("Measured: ground-truth speed").
 #
 #   blender -b --factory-startup -t T --python scripts/cycles_render.py -- \
-#       --scene DIR/scene.json --out DIR/cycles_16.exr --resolution 256 --samples 16 \
-#       --seed 1 --threads T
+#       --scene DIR/scene.json --out DIR/cycles_16.exr --width 256 --height 256 --samples 16 \
+#       --seed 1 --threads T [--textures]
 import argparse
 import json
 import math
@@ -25,7 +29,10 @@ argv = sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else []
 ap = argparse.ArgumentParser(prog="cycles_render.py")
 ap.add_argument("--scene", required=True, help="gilab scene description (.json): gltf, camera")
 ap.add_argument("--out", required=True, help="output .exr")
-ap.add_argument("--resolution", type=int, default=256)
+ap.add_argument("--width", type=int, default=256)
+ap.add_argument("--height", type=int, default=256)
+ap.add_argument("--textures", action="store_true",
+                help="keep the importer's base-colour textures (else the factors only)")
 ap.add_argument("--samples", type=int, default=16)
 ap.add_argument("--seed", type=int, default=1)
 ap.add_argument("--threads", type=int, default=2)
@@ -51,20 +58,60 @@ bpy.ops.import_scene.gltf(filepath=gltf_path)
 scene = bpy.context.scene
 
 
-def diffuse_emission_material(name, gm):
-    """Diffuse BSDF + Emission from the glTF material dict gm (glTF defaults when absent)."""
-    base = gm.get("pbrMetallicRoughness", {}).get("baseColorFactor", [1, 1, 1, 1])
+def imported_base_colour(mat):
+    """The socket the importer linked to its Principled BSDF's Base Color (texture x factor),
+    or None."""
+    if mat is None or not mat.use_nodes:
+        return None
+    for node in mat.node_tree.nodes:
+        if node.type == "BSDF_PRINCIPLED" and node.inputs["Base Color"].is_linked:
+            return node.inputs["Base Color"].links[0].from_socket
+    return None
+
+
+def diffuse_emission_material(name, gm, imported):
+    """Diffuse BSDF + Emission from the glTF material dict gm (glTF defaults when absent). With
+    --textures the imported material `imported` is rebuilt in place, keeping its base-colour
+    texture nodes."""
+    pbr = gm.get("pbrMetallicRoughness", {})
+    base = pbr.get("baseColorFactor", [1, 1, 1, 1])
     emissive = gm.get("emissiveFactor", [0, 0, 0])
     strength = gm.get("extensions", {}).get("KHR_materials_emissive_strength", {}).get(
         "emissiveStrength", 1.0)
-    if "baseColorTexture" in gm.get("pbrMetallicRoughness", {}) or "emissiveTexture" in gm:
+    if pbr.get("metallicFactor", 1.0) != 0.0 or pbr.get("roughnessFactor", 1.0) != 1.0 or \
+            "metallicRoughnessTexture" in pbr:
+        sys.exit(f"cycles_render: material {name} is not Lambertian (metallic 0, roughness 1); "
+                 "the cross-check rebuilds every material as a diffuse BSDF")
+    if gm.get("alphaMode", "OPAQUE") != "OPAQUE":
+        sys.exit(f"cycles_render: material {name}: alphaMode {gm['alphaMode']} is not supported")
+    textured = "baseColorTexture" in pbr
+    if "emissiveTexture" in gm or (textured and not args.textures):
         print(f"cycles_render: material {name}: textures ignored (factors only)")
-    mat = bpy.data.materials.new(name + ".crosscheck")
-    mat.use_nodes = True
-    nodes, links = mat.node_tree.nodes, mat.node_tree.links
-    nodes.clear()
+    colour = imported_base_colour(imported) if textured and args.textures else None
+    if textured and args.textures and colour is None:
+        sys.exit(f"cycles_render: material {name}: the importer linked no base-colour texture")
+    if colour is not None:
+        mat = imported  # keep its texture and UV nodes, replace the rest
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        keep = set()
+        stack = [colour.node]
+        while stack:  # the base colour's upstream nodes
+            node = stack.pop()
+            if node.name not in keep:
+                keep.add(node.name)
+                stack += [link.from_node for i in node.inputs for link in i.links]
+        for node in list(nodes):
+            if node.name not in keep:
+                nodes.remove(node)
+    else:
+        mat = bpy.data.materials.new(name + ".crosscheck")
+        mat.use_nodes = True
+        nodes, links = mat.node_tree.nodes, mat.node_tree.links
+        nodes.clear()
     diffuse = nodes.new("ShaderNodeBsdfDiffuse")
     diffuse.inputs["Color"].default_value = (*base[:3], 1.0)
+    if colour is not None:
+        links.new(colour, diffuse.inputs["Color"])
     diffuse.inputs["Roughness"].default_value = 0.0  # 0 = Lambertian (no Oren-Nayar)
     emission = nodes.new("ShaderNodeEmission")
     emission.inputs["Color"].default_value = (*emissive[:3], 1.0)
@@ -74,7 +121,8 @@ def diffuse_emission_material(name, gm):
     links.new(diffuse.outputs["BSDF"], add.inputs[0])
     links.new(emission.outputs["Emission"], add.inputs[1])
     links.new(add.outputs["Shader"], out.inputs["Surface"])
-    print(f"cycles_render: {name}: diffuse {base[:3]}, emission {emissive[:3]} x {strength}")
+    print(f"cycles_render: {name}: diffuse {'texture x ' if colour else ''}{base[:3]}, "
+          f"emission {emissive[:3]} x {strength}")
     return mat
 
 
@@ -92,7 +140,7 @@ for obj in scene.objects:
         if slot.material and name not in by_name:
             sys.exit(f"cycles_render: material {slot.material.name} is not in {gltf_path}")
         if name not in replaced:
-            replaced[name] = diffuse_emission_material(name, by_name.get(name, {}))
+            replaced[name] = diffuse_emission_material(name, by_name.get(name, {}), slot.material)
         slot.material = replaced[name]
 
 # Camera: glTF Y-up -> Blender Z-up as the importer does it, (x, y, z) -> (x, -z, y).
@@ -103,7 +151,7 @@ def to_blender(v):
     return Vector((v[0], -v[2], v[1]))
 
 
-pos, target, up = (to_blender(cam_desc[k]) for k in ("position", "target", "up"))
+pos, target, up = (to_blender(cam_desc.get(k, [0, 1, 0])) for k in ("position", "target", "up"))
 cam_data = bpy.data.cameras.new("crosscheck")
 cam_data.sensor_fit = "VERTICAL"
 cam_data.angle_y = math.radians(cam_desc["vfov_deg"])
@@ -119,6 +167,26 @@ rot = Matrix((right, true_up, -forward)).transposed()
 cam.rotation_euler = rot.to_euler()
 scene.camera = cam
 
+# The scene description's lights (glTF lights are not used by gilab's cross-check scenes).
+for obj in [o for o in scene.objects if o.type == "LIGHT"]:
+    bpy.data.objects.remove(obj)
+for i, light in enumerate(desc.get("lights", [])):
+    if light.get("type") != "directional":
+        sys.exit(f"cycles_render: light {i}: type {light.get('type')} is not supported "
+                 "(directional only)")
+    d = to_blender(light["direction"]).normalized()  # the direction light travels
+    colour = light.get("color", [1, 1, 1])
+    sun = bpy.data.lights.new(light.get("name", f"sun{i}"), "SUN")
+    sun.energy = float(light.get("intensity", 1.0))  # irradiance, W/m^2
+    sun.color = colour[:3]
+    sun.angle = 0.0
+    if hasattr(sun, "cycles"):
+        sun.cycles.cast_shadow = True
+    obj = bpy.data.objects.new(sun.name, sun)
+    scene.collection.objects.link(obj)
+    obj.rotation_euler = d.to_track_quat("-Z", "Y").to_euler()  # a sun shines along its -Z
+    print(f"cycles_render: sun {sun.name}: direction {tuple(d)}, {sun.energy} x {colour[:3]}")
+
 # Black world.
 world = bpy.data.worlds.new("crosscheck")
 world.use_nodes = True
@@ -132,7 +200,7 @@ r, c = scene.render, scene.cycles
 r.engine = "CYCLES"
 c.device = "CPU"
 r.threads_mode, r.threads = "FIXED", args.threads
-r.resolution_x = r.resolution_y = args.resolution
+r.resolution_x, r.resolution_y = args.width, args.height
 r.resolution_percentage = 100
 r.pixel_aspect_x = r.pixel_aspect_y = 1
 r.film_transparent = False
@@ -166,9 +234,9 @@ img.file_format, img.color_mode, img.color_depth, img.exr_codec = "OPEN_EXR", "R
 r.filepath = os.path.abspath(args.out)
 r.use_file_extension = False
 
-t0 = time.perf_counter()
+t0, c0 = time.perf_counter(), time.process_time()
 bpy.ops.render.render(write_still=True)
-seconds = time.perf_counter() - t0
+seconds, cpu_seconds = time.perf_counter() - t0, time.process_time() - c0
 
 info = {
     "renderer": "cycles",
@@ -176,11 +244,12 @@ info = {
     "samples": args.samples,
     "seed": args.seed,
     "threads": args.threads,
-    "resolution": args.resolution,
+    "resolution": [args.width, args.height],
     "seconds": seconds,
+    "cpu_seconds": cpu_seconds,
     "seconds_per_sample": seconds / args.samples,
     "settings": {"device": "CPU", "max_bounces": args.max_bounces, "pixel_filter": "gaussian 0.01",
-                 "adaptive": False, "denoise": False, "clamp": 0,
+                 "adaptive": False, "denoise": False, "clamp": 0, "textures": args.textures,
                  "min_light_bounces": c.min_light_bounces,
                  "sampling_pattern": c.sampling_pattern},
 }

@@ -56,14 +56,18 @@ public:
 };
 
 /** A synthetic accumulator with irregular values (no rendering). */
-ref::Accumulator syntheticAccumulator(int w, int h, uint64_t samples) {
+ref::Accumulator syntheticAccumulator(int w, int h, uint64_t samples, uint32_t replicate = 0) {
     ref::Accumulator acc;
-    acc.reset(w, h);
+    acc.reset(w, h, replicate);
     acc.samples = samples;
     acc.nonFiniteSamples = 3;
     for (size_t i = 0; i < acc.sum.size(); ++i) {
         acc.sum[i] = double(i) * 0.1234567 + 1.0 / double(i + 3);
         acc.sumSq[i] = acc.sum[i] * acc.sum[i] * 1.5 + 1e-9 * double(i);
+        if (replicate > 0) {
+            acc.replicateSumSq[i] = acc.sumSq[i] * 0.75 + 1e-7 * double(i);
+            acc.replicateOpen[i] = 0.5 / double(i + 1);
+        }
     }
     return acc;
 }
@@ -78,7 +82,9 @@ bool bitEqual(const ref::Accumulator& a, const ref::Accumulator& b) {
            a.nonFiniteSamples == b.nonFiniteSamples && a.sum.size() == b.sum.size() &&
            a.sumSq.size() == b.sumSq.size() &&
            std::memcmp(a.sum.data(), b.sum.data(), a.sum.size() * sizeof(double)) == 0 &&
-           std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0;
+           std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0 &&
+           a.replicate == b.replicate && a.replicateSumSq == b.replicateSumSq &&
+           a.replicateOpen == b.replicateOpen;
 }
 
 std::string errorOf(const std::function<void()>& f) {
@@ -126,6 +132,12 @@ TEST(CpuReferenceKey, EveryImageInputChangesTheKey) {
         {"estimator", [](Scene&, auto& r) { r.estimator = ref::Estimator::NeeOnly; }},
         {"seed", [](Scene&, auto& r) { r.seed += 1; }},
         {"pixel filter", [](Scene&, auto& r) { r.pixelFilter = ref::PixelFilter::Box; }},
+        {"sampler", [](Scene&, auto& r) { r.sampler = ref::SamplerKind::Sobol; }},
+        {"sobol replicate",
+         [](Scene&, auto& r) {
+             r.sampler = ref::SamplerKind::Sobol;
+             r.sobolReplicate = 16;
+         }},
     };
     std::set<std::string> keys = {ref::referenceKey(tinyScene(), tinySettings())};
     for (const auto& [what, edit] : edits) {
@@ -205,6 +217,33 @@ TEST(CpuReferenceCache, AccumulatorRoundTripIsBitExact) {
     ASSERT_EQ(layers.size(), size_t(2 * ref::kLayerCount));
     EXPECT_EQ(layers[0].name, "full");
     EXPECT_EQ(layers[ref::kLayerCount].name, "full_stderr");
+}
+
+TEST(CpuReferenceCache, SobolReplicateSumsRoundTripAndIndependentFilesKeepFormat1) {
+    TempDir tmp;
+    const ref::Accumulator sobol = syntheticAccumulator(4, 3, 96, 16);
+    ref::writeAccumulatorFile(tmp.path() / "s.bin", sobol);
+    const ref::Accumulator back = ref::readAccumulatorFile(tmp.path() / "s.bin");
+    EXPECT_TRUE(bitEqual(back, sobol));
+    EXPECT_EQ(back.replicate, 16u);
+    EXPECT_DOUBLE_EQ(back.stdError(ref::Layer::Direct, 1, 2, 1),
+                     sobol.stdError(ref::Layer::Direct, 1, 2, 1));
+    // Format 1 (no replicates) is unchanged: 48-byte header, two arrays, checksum
+    const ref::Accumulator iid = syntheticAccumulator(4, 3, 96);
+    ref::writeAccumulatorFile(tmp.path() / "i.bin", iid);
+    EXPECT_EQ(std::filesystem::file_size(tmp.path() / "i.bin"),
+              48u + 2u * iid.sum.size() * sizeof(double) + 16u);
+    EXPECT_EQ(std::filesystem::file_size(tmp.path() / "s.bin"),
+              56u + 4u * iid.sum.size() * sizeof(double) + 16u);
+    // A replicate size that is not a power of two is named as corrupt
+    std::fstream f(tmp.path() / "s.bin", std::ios::in | std::ios::out | std::ios::binary);
+    const uint64_t bad = 12;
+    f.seekp(48);
+    f.write(reinterpret_cast<const char*>(&bad), sizeof bad);
+    f.close();
+    const std::string e = errorOf([&] { ref::readAccumulatorFile(tmp.path() / "s.bin"); });
+    EXPECT_NE(e.find("s.bin"), std::string::npos) << e;
+    EXPECT_NE(e.find("replicate"), std::string::npos) << e;
 }
 
 TEST(CpuReferenceCache, StoreReplacesAnEntryAndLeavesNoTemporaries) {
@@ -519,6 +558,7 @@ TEST(CpuReferenceCommand, LongReferenceAddsTheConvergenceCurve) {
     ASSERT_EQ(cli::runReference(o), cli::kExitOk);
     o.spp = 8;
     o.seed = 1;
+    o.batchSamples = 4;
     o.outDir = (tmp.path() / "short").string();
     o.longReference = (tmp.path() / "long" / "reference.exr").string();
     ASSERT_EQ(cli::runReference(o), cli::kExitOk);

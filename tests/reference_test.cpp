@@ -559,7 +559,9 @@ TEST(CpuReferenceLayers, LayersSumToFull) {
 bool sameSums(const Accumulator& a, const Accumulator& b) {
     return a.samples == b.samples && a.sum.size() == b.sum.size() &&
            std::memcmp(a.sum.data(), b.sum.data(), a.sum.size() * sizeof(double)) == 0 &&
-           std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0;
+           std::memcmp(a.sumSq.data(), b.sumSq.data(), a.sumSq.size() * sizeof(double)) == 0 &&
+           a.replicate == b.replicate && a.replicateSumSq == b.replicateSumSq &&
+           a.replicateOpen == b.replicateOpen;
 }
 
 void checkThreadsBatchesAndSeeds(SamplerKind sampler) {
@@ -568,6 +570,7 @@ void checkThreadsBatchesAndSeeds(SamplerKind sampler) {
     scene.computeCaps();
     ReferenceSettings st = settingsWith(Estimator::Mis, 4, 11);
     st.sampler = sampler;
+    st.sobolReplicate = 2;       // replicates end inside and between the calls below
     st.rouletteStartBounce = 1;  // the roulette's draws are part of the stream too
     auto renderWith = [&](int threads, std::vector<uint32_t> batches, uint64_t seed) {
         tbb::global_control limit(tbb::global_control::max_allowed_parallelism, size_t(threads));
@@ -657,6 +660,100 @@ TEST(CpuReferenceSampler, SobolDrawsAreStratifiedPerPixelAndLaterDrawsVary) {
     }
     EXPECT_EQ(distinct, 1024);
     EXPECT_NEAR(sum / 1024.0, 0.5, 4.0 * std::sqrt(1.0 / 12.0 / 1024.0));
+}
+
+TEST(CpuReferenceSampler, SobolDimension1TablesMatchTheDirectionNumbers) {
+    // Sobol dimension 1 by its definition: x = xor of v_j over the set bits j of i
+    auto direct = [](uint32_t i) {
+        uint32_t x = 0;
+        for (uint32_t v = 1u << 31; i != 0; i >>= 1, v ^= v >> 1)
+            if (i & 1u) x ^= v;
+        return x;
+    };
+    uint64_t state = 1;
+    for (int k = 0; k < 100000; ++k) {
+        const uint32_t i = k < 4096 ? uint32_t(k) : uint32_t(mix64(++state));
+        ASSERT_EQ(sobolDimension1(i), direct(i)) << i;
+        ASSERT_EQ(detail::kSobolDimension1Reversed(i), reverseBits32(direct(i))) << i;
+    }
+    // The first points of the (0, 2)-sequence: 1/2, 3/4, 1/4, 3/8 in dimension 1
+    EXPECT_EQ(sobolDimension1(1), 0x80000000u);
+    EXPECT_EQ(sobolDimension1(2), 0xc0000000u);
+    EXPECT_EQ(sobolDimension1(3), 0x40000000u);
+    EXPECT_EQ(sobolDimension1(4), 0xa0000000u);
+}
+
+TEST(CpuReferenceSampler, SobolReplicatesAreIndependentlyScrambledNets) {
+    // Replicates of 64: samples [64r, 64r + 64) of a pixel are an 8 x 8-stratified net of their
+    // own; two replicates are different point sets (their own scrambles)
+    auto points = [](uint32_t replicate) {
+        std::vector<glm::vec2> p;
+        int cells[8][8] = {};
+        for (uint32_t s = 64 * replicate; s < 64 * replicate + 64; ++s) {
+            Sampler sm(7, 99, s, SamplerKind::Sobol, 6);
+            sm.get2D();  // the camera pad
+            p.push_back(sm.get2D());
+            ++cells[int(p.back().x * 8)][int(p.back().y * 8)];
+        }
+        for (auto& row : cells)
+            for (int c : row)
+                EXPECT_EQ(c, 1) << "replicate " << replicate;
+        return p;
+    };
+    const std::vector<glm::vec2> a = points(0), b = points(1), c = points(5);
+    EXPECT_NE(a, b);
+    EXPECT_NE(b, c);
+    // Replicate 0 of 64 is the first 64 samples of the unreplicated sequence
+    for (uint32_t s = 0; s < 64; ++s) {
+        Sampler whole(7, 99, s, SamplerKind::Sobol);
+        whole.get2D();
+        EXPECT_EQ(whole.get2D(), a[s]);
+    }
+}
+
+TEST(CpuReferenceSampler, SobolErrorBarsFromReplicatesAreHonest) {
+    // A plane under a square emitter, direct light through pixel centres (where Sobol pays
+    // most). Over pixels, the squared difference of two seeds' images is twice the variance of
+    // either; the stderr^2 of the replicates must match it, the i.i.d. formula over-estimates.
+    const Camera cam = lookDown({0.0f, 0.5f, 0.0f}, 40.0f);
+    Scene s = planeScene(12, cam);
+    addHorizontalQuad(s, 1.0f, 0.25f, -1.0f,
+                      addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(3.0f, 2.0f, 1.0f))));
+    ReferenceSettings st = settingsWith(Estimator::Mis, 0);
+    st.pixelFilter = PixelFilter::Center;
+    st.sampler = SamplerKind::Sobol;
+    st.sobolReplicate = 8;
+    double diff2 = 0.0, replicateVar = 0.0, iidVar = 0.0;
+    for (uint64_t seed = 1; seed <= 8; seed += 2) {
+        st.seed = seed;
+        const Accumulator a = render(s, st, 128);
+        st.seed = seed + 1;
+        const Accumulator b = render(s, st, 128);
+        ASSERT_TRUE(a.replicateErrors());
+        for (const Accumulator* acc : {&a, &b})
+            for (int y = 0; y < acc->height; ++y)
+                for (int x = 0; x < acc->width; ++x) {
+                    const double e = acc->stdError(Layer::Direct, x, y, 0);
+                    replicateVar += e * e / 2.0;
+                    // The i.i.d. formula from the same sums
+                    const size_t i = acc->index(Layer::Direct, x, y, 0);
+                    const double n = double(acc->samples), m = acc->sum[i] / n;
+                    iidVar += (acc->sumSq[i] - n * m * m) / (n - 1.0) / n / 2.0;
+                }
+        for (int y = 0; y < a.height; ++y)
+            for (int x = 0; x < a.width; ++x) {
+                const double d = a.mean(Layer::Direct, x, y, 0) - b.mean(Layer::Direct, x, y, 0);
+                diff2 += d * d / 2.0;
+            }
+    }
+    std::printf(
+        "[ measured ] direct light, Sobol 128 spp in replicates of 8: variance from "
+        "seed pairs %.4g, from replicates %.4g (ratio %.3f), i.i.d. formula %.4g "
+        "(ratio %.3f)\n",
+        diff2, replicateVar, replicateVar / diff2, iidVar, iidVar / diff2);
+    EXPECT_GT(replicateVar / diff2, 0.75);
+    EXPECT_LT(replicateVar / diff2, 1.33);
+    EXPECT_GT(iidVar / diff2, 1.5);
 }
 
 TEST(CpuReferenceSampler, SobolHasLowerErrorThanIndependentUnderAnAreaLight) {
@@ -1078,7 +1175,7 @@ TEST(CpuReferenceStop, DescriptionNamesEverySetting) {
     const std::string version = "v" + std::to_string(kRendererVersion);
     for (const char* part :
          {version.c_str(), "estimator: nee", "max_bounces: 9", "roulette_start_bounce: 3",
-          "seed: 42", "batch_samples: 4", "pixel filter: ", "ray_offsets: ", "embree: 3."})
+          "seed: 42", "batch_samples: 16", "pixel filter: ", "ray_offsets: ", "embree: 3."})
         EXPECT_NE(d.find(part), std::string::npos) << part << " in\n" << d;
     // One description of the pixel filter, the one in use (it was also a fixed "box" line)
     EXPECT_EQ(d.find("pixel_filter:"), std::string::npos) << d;

@@ -1,5 +1,6 @@
 #include "core/util/progress.h"
 
+#include <time.h>
 #include <unistd.h>
 
 #include <cstdio>
@@ -61,6 +62,12 @@ void Progress::print(bool final) {
                  m_label.c_str(), counts, elapsed, m_detail.c_str(),
                  (final || !isTerminal()) ? "\n" : "");
     std::fflush(stderr);
+}
+
+double processCpuSeconds() {
+    timespec t{};
+    if (clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t) != 0) return 0.0;
+    return double(t.tv_sec) + double(t.tv_nsec) * 1e-9;
 }
 
 }  // namespace gilab

@@ -44,4 +44,7 @@ private:
     std::chrono::steady_clock::time_point m_start;
 };
 
+/** CPU time of the whole process (every thread, user + system) in seconds. */
+double processCpuSeconds();
+
 }  // namespace gilab

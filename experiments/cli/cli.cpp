@@ -219,8 +219,13 @@ int runMain(int argc, char** argv) {
         ->capture_default_str();
     ref->add_option("--sampler", reference.sampler,
                     "independent: i.i.d. uniforms (exact per-pixel error bars); sobol: "
-                    "Owen-scrambled Sobol (faster convergence, conservative error bars)")
+                    "Owen-scrambled Sobol in scrambled replicates (error bars from their spread)")
         ->check(CLI::IsMember({"independent", "sobol"}))
+        ->capture_default_str();
+    ref->add_option("--sobol-replicate", reference.sobolReplicate,
+                    "Sobol: samples per independently scrambled replicate, a power of two (the "
+                    "replicates' spread gives the error bars)")
+        ->check(CLI::Range(1u, 1u << 30))
         ->capture_default_str();
     ref->add_option("--batch", reference.batchSamples,
                     "Samples per pass (stop criteria are checked between passes; no effect on "

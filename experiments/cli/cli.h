@@ -111,8 +111,9 @@ struct ReferenceOptions {
     std::string estimator = "mis";        // mis | nee | bsdf
     std::string pixelFilter = "center";   // "center" (the rasteriser's footprint) | "box"
     std::string sampler = "independent";  // "independent" | "sobol"
+    uint32_t sobolReplicate = ref::ReferenceSettings{}.sobolReplicate;
     uint64_t seed = 1;
-    uint32_t batchSamples = 4;
+    uint32_t batchSamples = ref::ReferenceSettings{}.batchSamples;
     std::string frames;      // animated scenes: "all", "every:K", "0,4,8"; "" = static
     std::string resolution;  // "WxH", "" = the scene's
     std::string cacheDir;    // "" = $GILAB_REFERENCE_CACHE or results/cache/reference

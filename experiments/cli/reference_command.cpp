@@ -93,6 +93,7 @@ int renderReference(const ReferenceOptions& options, const Scene& scene,
         options.pixelFilter == "center" ? ref::PixelFilter::Center : ref::PixelFilter::Box;
     settings.sampler =
         options.sampler == "sobol" ? ref::SamplerKind::Sobol : ref::SamplerKind::Independent;
+    settings.sobolReplicate = options.sobolReplicate;
     settings.seed = options.seed;
     settings.batchSamples = options.batchSamples;
     ref::StopCriteria stop{options.spp, options.relError, options.seconds};

@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -65,7 +66,7 @@ ReferenceRequest parseReference(const JsonNode& node) {
     ReferenceRequest r;
     node.expectKeys({"spp", "rel_error", "time_s", "max_bounces", "roulette_start_bounce",
                      "roulette_threshold", "seed", "estimator", "batch_spp", "pixel_filter",
-                     "sampler", "frames"});
+                     "sampler", "sobol_replicate", "frames"});
     if (node.has("frames")) {
         const JsonNode f = node["frames"];
         if (f.raw().is_string()) {
@@ -85,6 +86,12 @@ ReferenceRequest parseReference(const JsonNode& node) {
     if (node.has("roulette_threshold"))
         r.settings.rouletteThreshold = float(node["roulette_threshold"].numberIn(1e-6, 1.0));
     if (node.has("seed")) r.settings.seed = uint64_t(node["seed"].integerIn(0, 1 << 30));
+    if (node.has("sobol_replicate")) {
+        const int64_t n = node["sobol_replicate"].integerIn(1, 1 << 30);
+        if (!std::has_single_bit(uint64_t(n)))
+            node["sobol_replicate"].fail("expected a power of two (got " + std::to_string(n) + ")");
+        r.settings.sobolReplicate = uint32_t(n);
+    }
     if (node.has("batch_spp"))
         r.settings.batchSamples = uint32_t(node["batch_spp"].integerIn(1, 4096));
     if (node.has("pixel_filter")) {

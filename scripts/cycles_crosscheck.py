@@ -1,0 +1,214 @@
+#!/usr/bin/python3
+"""Analysis half of scripts/cycles_crosscheck.sh: time to a relative MSE of 1e-3, gilab's
+reference path tracer against Blender Cycles, from seed pairs rendered in interleaved rounds.
+
+For each renderer and round, two renders x1, x2 of n samples with different seeds give the
+relative MSE of ONE sample (its variance, weighted as gilab's relMSE):
+
+    a = n * mean over pixels and RGB of (x1 - x2)^2 / (y^2 + 1e-2) / 2
+
+No converged image enters a, so neither renderer's bias does. The weight's y must not depend
+on x1, x2 (their own mean correlates with their difference and biases a low: measured -16 % at
+256 spp on the Cornell box, docs/reference.md): it is the sample-weighted mean of every OTHER
+render of both renderers. Then spp to 1e-3 = a / 1e-3 and time to 1e-3 = spp x s/spp, with
+s/spp the marginal cost of a sample: (t(n) - t(1)) / (n - 1), t(1) from a 1-sample render of the
+round (it removes set-up both renderers repeat per render: Cycles' scene sync and BVH build,
+file writes). The same with CPU time (every thread). The ratio gilab / Cycles is taken per round
+(the machine's speed drifts between rounds; the renderers of one round ran interleaved).
+
+usage: cycles_crosscheck.py OUT_DIR   (reads OUT_DIR/runs.json written by the shell script)
+Writes OUT_DIR/crosscheck.json and OUT_DIR/crosscheck.md.
+"""
+import json
+import os
+import sys
+
+import numpy as np
+
+EPS, TARGET = 1e-2, 1e-3
+LUM = np.array([0.2126, 0.7152, 0.0722])
+
+
+def read_rgb(path, layer=None):
+    """RGB (or layer.RGB) of an EXR as float64 (h, w, 3), via the OpenImageIO module."""
+    import OpenImageIO as oiio
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        sys.exit(f"cycles_crosscheck: cannot read {path}: {oiio.geterror()}")
+    spec, px = inp.spec(), inp.read_image("float")
+    inp.close()
+    names = [f"{layer}.{c}" if layer else c for c in "RGB"]
+    missing = [n for n in names if n not in spec.channelnames]
+    if missing:
+        sys.exit(f"cycles_crosscheck: {path} has no channels {missing}")
+    return np.stack([px[..., spec.channelnames.index(n)] for n in names], -1).astype(float)
+
+
+def load_render(out, run):
+    """A run of runs.json: its image and timing sidecar."""
+    if run["renderer"] == "gilab":
+        info = json.load(open(os.path.join(out, run["path"], "reference.json")))
+        image = read_rgb(os.path.join(out, run["path"], "reference.exr"), "full")
+    else:
+        info = json.load(open(os.path.join(out, run["path"] + ".json")))
+        image = read_rgb(os.path.join(out, run["path"] + ".exr"))
+    cpu = info.get("cpu_seconds")  # absent from gilab binaries before 2026-12-03: CPU n/a
+    return {**run, "seconds": float(info["seconds"]),
+            "cpu_seconds": float(cpu) if cpu is not None else float("nan"), "image": image,
+            "info": info}
+
+
+def weighted_mean(renders):
+    total = sum(r["spp"] for r in renders)
+    return sum(r["image"] * r["spp"] for r in renders) / total
+
+
+def per_sample_mse(x1, x2, n, y):
+    """a from a seed pair of n samples each (module docstring)."""
+    return n * float(np.mean((x1 - x2) ** 2 / (y * y + EPS))) / 2.0
+
+
+def analyse(renders):
+    """Per renderer and round: a, marginal s/spp (wall, CPU) and the time to 1e-3; per round the
+    ratios gilab / Cycles; over rounds their spread."""
+    pairs = [r for r in renders if r["spp"] > 1]
+    rows = []
+    for renderer in ("gilab", "cycles"):
+        for rnd in sorted({r["round"] for r in pairs}):
+            pair = [r for r in pairs if r["renderer"] == renderer and r["round"] == rnd]
+            setup = [r for r in renders
+                     if r["renderer"] == renderer and r["round"] == rnd and r["spp"] == 1]
+            if len(pair) != 2 or len(setup) != 1 or pair[0]["spp"] != pair[1]["spp"]:
+                sys.exit(f"cycles_crosscheck: round {rnd} lacks {renderer}'s seed pair or its "
+                         "1-sample render")
+            n = pair[0]["spp"]
+            others = [r for r in pairs if r not in pair]
+            y = weighted_mean(others)
+            a = per_sample_mse(pair[0]["image"], pair[1]["image"], n, y)
+            wall = np.mean([(r["seconds"] - setup[0]["seconds"]) / (n - 1) for r in pair])
+            cpu = np.mean([(r["cpu_seconds"] - setup[0]["cpu_seconds"]) / (n - 1) for r in pair])
+            rows.append({"renderer": renderer, "round": rnd, "spp": n, "seeds": [r["seed"] for r in pair],
+                         "a": a, "s_per_spp": float(wall), "cpu_s_per_spp": float(cpu),
+                         "setup_seconds": setup[0]["seconds"],
+                         "seconds_to_target": a / TARGET * float(wall),
+                         "cpu_seconds_to_target": a / TARGET * float(cpu)})
+    ratios = []
+    for rnd in sorted({r["round"] for r in rows}):
+        g = next(r for r in rows if r["renderer"] == "gilab" and r["round"] == rnd)
+        c = next(r for r in rows if r["renderer"] == "cycles" and r["round"] == rnd)
+        ratios.append({"round": rnd,
+                       "wall": g["seconds_to_target"] / c["seconds_to_target"],
+                       "cpu": g["cpu_seconds_to_target"] / c["cpu_seconds_to_target"],
+                       "a": g["a"] / c["a"], "s_per_spp": g["s_per_spp"] / c["s_per_spp"]})
+    spread = {k: [min(r[k] for r in ratios), max(r[k] for r in ratios)]
+              for k in ("wall", "cpu", "a", "s_per_spp")}
+    return rows, ratios, spread
+
+
+def agreement(renders):
+    """Every sample of each renderer pooled: mean ratio Cycles / gilab (with one standard error
+    from the seed pairs' noise) and their relative MSE beyond both images' expected noise."""
+    pooled = {r: [x for x in renders if x["renderer"] == r and x["spp"] > 1]
+              for r in ("gilab", "cycles")}
+    g, c = weighted_mean(pooled["gilab"]), weighted_mean(pooled["cycles"])
+    y = (g + c) / 2
+    npx = g.shape[0] * g.shape[1]
+
+    def noise(runs):
+        """Per-pixel variance of the pooled mean, from the rounds' seed pairs."""
+        var = np.zeros_like(g)
+        total = sum(r["spp"] for r in runs)
+        for rnd in sorted({r["round"] for r in runs}):
+            x1, x2 = [r for r in runs if r["round"] == rnd]
+            var += (x1["image"] - x2["image"]) ** 2 / 2 * x1["spp"]  # per-sample variance
+        return var / len({r["round"] for r in runs}) / total
+
+    vg, vc = noise(pooled["gilab"]), noise(pooled["cycles"])
+    mg, mc = g.mean((0, 1)), c.mean((0, 1))
+    sig = np.sqrt(vc.sum((0, 1)) / npx**2 / mc**2 + vg.sum((0, 1)) / npx**2 / mg**2)
+    lg, lc = float(mg @ LUM), float(mc @ LUM)
+    sig_lum = np.sqrt(float((vc * LUM**2).sum()) / npx**2 / lc**2
+                      + float((vg * LUM**2).sum()) / npx**2 / lg**2)
+    w = 1.0 / (y * y + EPS)
+    rel = float(np.mean((c - g) ** 2 * w))
+    expected = float(np.mean((vg + vc) * w))
+    flips = {"none": rel, "left-right": float(np.mean((c[:, ::-1] - g) ** 2 * w)),
+             "up-down": float(np.mean((c[::-1] - g) ** 2 * w))}
+    return {"ratio_cycles_over_gilab": (mc / mg).tolist() + [lc / lg],
+            "ratio_sigma": sig.tolist() + [float(sig_lum)],
+            "rel_mse": rel, "rel_mse_expected_noise": expected,
+            "rel_mse_minus_noise": rel - expected,
+            "orientation_rel_mse": flips,
+            "orientation_ok": min(flips, key=flips.get) == "none"}
+
+
+def markdown(meta, rows, ratios, spread, agree):
+    lines = [f"# Cycles cross-check: {meta['scene']} ({meta['width']}x{meta['height']}, "
+             f"{meta['max_bounces']} bounces, {meta['threads']} threads)", "",
+             f"gilab reference path tracer v{meta['gilab_version']} ({meta['gilab_sampler']} "
+             f"sampler) vs Blender {meta['blender_version']} Cycles (CPU, its defaults). "
+             f"{len(ratios)} rounds, each: gilab seed 1, Cycles seed 1, gilab seed 2, Cycles seed "
+             "2 (then one 1-sample render each, for the set-up time). Machine: "
+             f"{meta['machine']}; {meta['date']}.", "",
+             "a = n * relMSE(x1, x2) / 2 per seed pair (weights from the other renders); s/spp "
+             "= marginal cost of a sample; time to 1e-3 = a / 1e-3 * s/spp.", "",
+             "| round | renderer | spp | a | s/spp (wall) | CPU s/spp | set-up s | time to 1e-3 "
+             "| CPU time to 1e-3 |",
+             "|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in sorted(rows, key=lambda r: (r["round"], r["renderer"] != "gilab")):
+        lines.append(f"| {r['round']} | {r['renderer']} | {r['spp']} | {r['a']:.3f} | "
+                     f"{r['s_per_spp']:.4f} | {r['cpu_s_per_spp']:.4f} | "
+                     f"{r['setup_seconds']:.2f} | {r['seconds_to_target']:.1f} s | "
+                     f"{r['cpu_seconds_to_target']:.1f} s |")
+    lines += ["", "| round | gilab / Cycles: wall time to 1e-3 | CPU time | a | s/spp |",
+              "|---:|---:|---:|---:|---:|"]
+    for q in ratios:
+        lines.append(f"| {q['round']} | **{q['wall']:.3f}** | **{q['cpu']:.3f}** | "
+                     f"{q['a']:.3f} | {q['s_per_spp']:.3f} |")
+    lines.append(f"| spread | {spread['wall'][0]:.3f}–{spread['wall'][1]:.3f} | "
+                 f"{spread['cpu'][0]:.3f}–{spread['cpu'][1]:.3f} | "
+                 f"{spread['a'][0]:.3f}–{spread['a'][1]:.3f} | "
+                 f"{spread['s_per_spp'][0]:.3f}–{spread['s_per_spp'][1]:.3f} |")
+    ratio = ", ".join(f"{k} {v:.4f} ± {e:.4f}" for k, v, e in
+                      zip("RGB", agree["ratio_cycles_over_gilab"], agree["ratio_sigma"]))
+    lum = agree["ratio_cycles_over_gilab"][3], agree["ratio_sigma"][3]
+    lines += ["", f"Agreement (every sample pooled): mean Cycles / gilab {ratio}, luminance "
+              f"{lum[0]:.4f} ± {lum[1]:.4f} (one standard error); relMSE between them "
+              f"{agree['rel_mse']:.4g}, of which both images' noise explains "
+              f"{agree['rel_mse_expected_noise']:.4g} (excess {agree['rel_mse_minus_noise']:.3g})."
+              , "Orientation (relMSE, Cycles flipped): " +
+              ", ".join(f"{k} {v:.4g}" for k, v in agree["orientation_rel_mse"].items()) +
+              ("" if agree["orientation_ok"] else
+               "  ** a flipped image matches better: camera mismatch **")]
+    return "\n".join(lines) + "\n"
+
+
+def main():
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    out = sys.argv[1]
+    meta = json.load(open(os.path.join(out, "runs.json")))
+    renders = [load_render(out, r) for r in meta["runs"]]
+    gilab_info = next(r["info"] for r in renders if r["renderer"] == "gilab")
+    cycles_info = next(r["info"] for r in renders if r["renderer"] == "cycles")
+    meta.update({"gilab_version": gilab_info["renderer"]["version"],
+                 "gilab_sampler": gilab_info["settings"]["sampler"],
+                 "blender_version": cycles_info["blender_version"]})
+    rows, ratios, spread = analyse(renders)
+    agree = agreement(renders)
+    text = markdown(meta, rows, ratios, spread, agree)
+    print(text, end="")
+    with open(os.path.join(out, "crosscheck.md"), "w") as f:
+        f.write(text)
+    result = {k: v for k, v in meta.items() if k != "runs"}
+    result.update({"runs": [{k: v for k, v in r.items() if k not in ("image", "info")}
+                            for r in renders],
+                   "per_round": rows, "ratios": ratios, "spread": spread, "agreement": agree})
+    with open(os.path.join(out, "crosscheck.json"), "w") as f:
+        json.dump(result, f, indent=2)
+    print(f"wrote {out}/crosscheck.json and crosscheck.md")
+    return 0 if agree["orientation_ok"] else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
