@@ -711,14 +711,20 @@ TEST(CpuReferenceSampler, SobolReplicatesAreIndependentlyScrambledNets) {
     }
 }
 
+/** A 12 x 12 view of a plane under a square emitter: direct light through pixel centres, where
+ *  Sobol's stratification pays most. */
+Scene planeUnderSquareEmitter() {
+    Scene s = planeScene(12, lookDown({0.0f, 0.5f, 0.0f}, 40.0f));
+    addHorizontalQuad(s, 1.0f, 0.25f, -1.0f,
+                      addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(3.0f, 2.0f, 1.0f))));
+    return s;
+}
+
 TEST(CpuReferenceSampler, SobolErrorBarsFromReplicatesAreHonest) {
     // A plane under a square emitter, direct light through pixel centres (where Sobol pays
     // most). Over pixels, the squared difference of two seeds' images is twice the variance of
     // either; the stderr^2 of the replicates must match it, the i.i.d. formula over-estimates.
-    const Camera cam = lookDown({0.0f, 0.5f, 0.0f}, 40.0f);
-    Scene s = planeScene(12, cam);
-    addHorizontalQuad(s, 1.0f, 0.25f, -1.0f,
-                      addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(3.0f, 2.0f, 1.0f))));
+    const Scene s = planeUnderSquareEmitter();
     ReferenceSettings st = settingsWith(Estimator::Mis, 0);
     st.pixelFilter = PixelFilter::Center;
     st.sampler = SamplerKind::Sobol;
@@ -759,10 +765,7 @@ TEST(CpuReferenceSampler, SobolErrorBarsFromReplicatesAreHonest) {
 TEST(CpuReferenceSampler, SobolHasLowerErrorThanIndependentUnderAnAreaLight) {
     // A plane under a square emitter, direct light through pixel centres: the error of 64 spp
     // against 8192 i.i.d. spp, summed over pixels, must drop with the stratified sampler.
-    const Camera cam = lookDown({0.0f, 0.5f, 0.0f}, 40.0f);
-    Scene s = planeScene(12, cam);
-    addHorizontalQuad(s, 1.0f, 0.25f, -1.0f,
-                      addMaterial(s, lambert(glm::vec3(0.0f), glm::vec3(3.0f, 2.0f, 1.0f))));
+    const Scene s = planeUnderSquareEmitter();
     ReferenceSettings st = settingsWith(Estimator::Mis, 0);
     st.pixelFilter = PixelFilter::Center;
     const Accumulator truth = render(s, st, 8192);
