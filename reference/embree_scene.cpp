@@ -62,9 +62,9 @@ EmbreeScene::EmbreeScene(const Scene& scene, const TextureLookup& textures)
             tri.uv[k] = scene.vertices[tri.v[k]].uv;
         }
         tri.p0 = scene.vertices[tri.v[0]].position;
-        tri.e1 = scene.vertices[tri.v[1]].position - tri.p0;
-        tri.e2 = scene.vertices[tri.v[2]].position - tri.p0;
-        const glm::vec3 c = glm::cross(tri.e1, tri.e2);
+        tri.p1 = scene.vertices[tri.v[1]].position;
+        tri.p2 = scene.vertices[tri.v[2]].position;
+        const glm::vec3 c = glm::cross(tri.e1(), tri.e2());
         const float len = glm::length(c);
         tri.area = 0.5f * len;
         tri.n = len > 0.0f ? c / len : glm::vec3(0.0f);

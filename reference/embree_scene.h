@@ -23,12 +23,13 @@ namespace gilab::ref {
 
 class TextureLookup;
 
-/** One triangle: p = p0 + b1 e1 + b2 e2 with Embree's barycentrics (b1, b2) = (u, v). It also
- *  carries its vertices' normals and uvs, so that shading a hit reads one aligned 128-byte
- *  record (two adjacent cache lines) instead of the triangle plus three scattered vertices
- *  (docs/reference.md, "Throughput"). */
+/** One triangle: its three vertices as Embree sees them (the exact floats: the ray origins'
+ *  error margins are measured against these, reference/spawn.h), p = p0 + b1 e1 + b2 e2 with
+ *  Embree's barycentrics (b1, b2) = (u, v). It also carries its vertices' normals and uvs, so
+ *  that shading a hit reads one aligned 128-byte record (two adjacent cache lines) instead of
+ *  the triangle plus three scattered vertices (docs/reference.md, "Throughput"). */
 struct alignas(128) MeshTriangle {
-    glm::vec3 p0, e1, e2;
+    glm::vec3 p0, p1, p2;
     glm::vec3 n;  // unit geometric normal of the counter-clockwise winding (cross(e1, e2))
     float area = 0.0f;
     uint32_t material = 0;
@@ -40,6 +41,8 @@ struct alignas(128) MeshTriangle {
     glm::vec2 uvAt(float b1, float b2) const {
         return (1.0f - b1 - b2) * uv[0] + b1 * uv[1] + b2 * uv[2];
     }
+    glm::vec3 e1() const { return p1 - p0; }
+    glm::vec3 e2() const { return p2 - p0; }
 };
 static_assert(sizeof(MeshTriangle) == 128, "one triangle record is two cache lines");
 
@@ -82,6 +85,24 @@ public:
     void occludedStream(std::vector<RTCRay>& rays) const;
     /** rtcIntersect1M over `rays` (incoherent): the closest hits, in place. */
     void intersectStream(std::vector<RTCRayHit>& rays) const;
+    /** Calls visit(prim) for every triangle whose bounding box the sphere (p, radius) touches
+     *  (rtcPointQuery; a superset of the triangles within `radius`; the caller measures). */
+    template <class Visit>
+    void forEachNearby(const glm::vec3& p, float radius, Visit&& visit) const {
+        RTCPointQuery query;
+        query.x = p.x;
+        query.y = p.y;
+        query.z = p.z;
+        query.time = 0.0f;
+        query.radius = radius;
+        RTCPointQueryContext context;
+        rtcInitPointQueryContext(&context);
+        auto callback = [](RTCPointQueryFunctionArguments* args) -> bool {
+            (*static_cast<Visit*>(args->userPtr))(args->primID);
+            return false;  // the query sphere is unchanged
+        };
+        rtcPointQuery(m_scene, &query, &context, callback, &visit);
+    }
 
     /** Throws gilab::Error with Embree's message if the device reports an error. */
     void checkError(const char* what) const;

@@ -29,10 +29,10 @@ struct SurfacePoint {
 };
 
 SurfacePoint makeSurfacePoint(const Scene& scene, const MeshTriangle& tri, const RayHit& hit,
-                              const glm::vec3& wo) {
+                              const glm::dvec3& p, const glm::vec3& wo) {
     SurfacePoint sp;
     const float b1 = hit.u, b2 = hit.v, b0 = 1.0f - b1 - b2;
-    sp.p = tri.p0 + b1 * tri.e1 + b2 * tri.e2;
+    sp.p = glm::vec3(p);
     // Facing from the geometric normal, then the shading normal on the viewer's side of it
     // (gbuffer.frag; docs/shared_passes.md, "Facing")
     const glm::vec3 ngCcw = tri.area > 0.0f ? tri.n : wo;
@@ -45,24 +45,6 @@ SurfacePoint makeSurfacePoint(const Scene& scene, const MeshTriangle& tri, const
     sp.uv = tri.uvAt(b1, b2);
     sp.material = &scene.materials[tri.material];
     return sp;
-}
-
-/**
- * How far a hit point moves back along the ray that found it before its rays leave (world
- * units; at most half the ray's length). The point carries a rounding error of a few ulps of its
- * triangle's coordinates in every direction: at a concave edge it can fall a hair behind the
- * neighbouring face, which then blocks or swallows every ray leaving it, and the normal offset
- * moves it along its own face's normal only. The ray arrived through free space, so stepping
- * back along it clears every face; 1024 ulps of the triangle's largest coordinate cover the
- * error for rays down to 1/256 of grazing (docs/reference.md, "Ray offsets").
- */
-float spawnBackOff(const MeshTriangle& tri) {
-    auto maxAbs = [](const glm::vec3& v) {
-        return std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
-    };
-    const float m =
-        std::max(maxAbs(tri.p0), std::max(maxAbs(tri.p0 + tri.e1), maxAbs(tri.p0 + tri.e2)));
-    return m * 0x1p-13f;
 }
 
 bool isBlack(const glm::vec3& v) {
@@ -79,7 +61,7 @@ Integrator::Integrator(const Scene& scene, const ReferenceSettings& settings,
       m_mesh(mesh),
       m_lights(lights),
       m_textures(textures),
-      m_offsetScale(rayOffsetScale(scene.caps.bounds.lo, scene.caps.bounds.hi)) {}
+      m_spawn(mesh) {}
 
 bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& shadows) const {
     const Estimator estimator = m_settings.estimator;
@@ -90,7 +72,8 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
     const RayHit& hit = p.hit;
     const MeshTriangle& tri = m_mesh.triangle(hit.prim);
     const glm::vec3 wo = -p.rayD;
-    const SurfacePoint sp = makeSurfacePoint(m_scene, tri, hit, wo);
+    const glm::dvec3 hitPoint = exactHitPoint(tri, p.rayO, p.rayD, hit.u, hit.v);
+    const SurfacePoint sp = makeSurfacePoint(m_scene, tri, hit, hitPoint, wo);
     const Material& mat = *sp.material;
     const glm::vec3 beta = p.beta;
     const TextureFootprint* fp = k == 1 && p.hasFootprint ? &p.footprint : nullptr;
@@ -117,8 +100,8 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
     const glm::vec4 baseColor = lookupBaseColor(mat, m_textures, sp.uv, fp);
     const glm::vec2 metalRough = lookupMetalRough(mat, m_textures, sp.uv, fp);
     const Bsdf bsdf(sp.n, glm::vec3(baseColor), metalRough.x, metalRough.y);
-    const float backOff = std::min(spawnBackOff(tri), 0.5f * hit.t);
-    const glm::vec3 origin = offsetRayOrigin(sp.p + wo * backOff, sp.ng, m_offsetScale);
+    // Rays leave from a point in free space on wo's side of every nearby surface (spawn.h)
+    const glm::vec3 origin = m_spawn.origin(hitPoint, hit.prim, wo);
     const int layer = int(layerForVertex(k));
 
     // Next-event estimation: every punctual light (delta lights, lights.glsl formulas)
@@ -163,8 +146,7 @@ bool Integrator::shade(PathState& p, PathRadiance& out, std::vector<ShadowRay>& 
                     const float w = estimator == Estimator::Mis
                                         ? powerHeuristic(pdfLight, bsdf.pdf(wo, wi))
                                         : 1.0f;
-                    const glm::vec3 target =
-                        offsetRayOrigin(es.p, cosL > 0.0f ? lt.n : -lt.n, m_offsetScale);
+                    const glm::vec3 target = m_spawn.origin(glm::dvec3(es.p), es.prim, -wi);
                     shadows.push_back({origin, target - origin, kShadowTFar,
                                        beta * f * le * (cosTheta * w / pdfLight), p.slot, layer});
                 }

@@ -27,6 +27,7 @@
 #include "reference/embree_scene.h"
 #include "reference/path_tracer.h"
 #include "reference/sampling.h"
+#include "reference/spawn.h"
 #include "reference/texture_lookup.h"
 
 namespace gilab::ref {
@@ -114,7 +115,7 @@ private:
     const EmbreeScene& m_mesh;
     const LightSampler& m_lights;
     const TextureLookup& m_textures;
-    float m_offsetScale = 1.0f;  // offsetRayOrigin originScale of this scene
+    SpawnOffsets m_spawn;  // ray origins off every nearby surface
 };
 
 /** Closest-hit packets and a shadow-ray stream (default) or one Embree call per ray; for benchmarks

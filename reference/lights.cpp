@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "core/image/color.h"
+#include "core/scene/emission.h"
 #include "core/util/error.h"
 #include "reference/embree_scene.h"
 #include "reference/sampling.h"
@@ -54,14 +55,18 @@ LightSampler::LightSampler(const Scene& scene, const TextureLookup& textures,
         m_lights.push_back({light, std::cos(light.innerConeRad), std::cos(light.outerConeRad)});
     }
 
-    // Power table over the emissive triangles (Le averaged over the texture)
+    // Power table over the emissive triangles: Le averaged over each triangle's footprint in
+    // its emissive texture, floored at 1e-3 of the texture's whole mean so that a triangle
+    // whose footprint emits between the averaging points keeps a positive probability
     std::vector<double> power;
     for (uint32_t t = 0; t < uint32_t(mesh.triangleCount()); ++t) {
         const MeshTriangle& tri = mesh.triangle(t);
         const Material& m = scene.materials[tri.material];
         if (!m.isEmissive() || !(tri.area > 0.0f)) continue;
-        glm::vec3 le = m.emissiveFactor;
-        if (m.emissiveTexture >= 0) le *= glm::vec3(textures.average(m.emissiveTexture));
+        glm::vec3 le = meanTriangleEmission(scene, t);
+        if (m.emissiveTexture >= 0)
+            le = glm::max(
+                le, 1e-3f * m.emissiveFactor * glm::vec3(textures.average(m.emissiveTexture)));
         const double p = double(luminance(le)) * double(tri.area) * (m.doubleSided ? 2.0 : 1.0);
         if (!(p > 0.0)) continue;
         if (!std::isfinite(p))
@@ -99,7 +104,7 @@ bool LightSampler::sampleEmitter(double uSelect, glm::vec2 u, EmitterSample& out
     const MeshTriangle& tri = m_mesh.triangle(prim);
     out.prim = prim;
     out.bary = sampleUniformTriangle(u);
-    out.p = tri.p0 + out.bary.x * tri.e1 + out.bary.y * tri.e2;
+    out.p = tri.p0 + out.bary.x * tri.e1() + out.bary.y * tri.e2();
     out.pdfArea = m_pdfArea[prim];
     return out.pdfArea > 0.0f;
 }

@@ -8,9 +8,11 @@
  *
  * Emissive triangles are sampled by power: triangle i is picked with probability proportional
  * to luminance(Le_i) x area_i (x 2 when double-sided) from a CDF over the emissive triangles,
- * then a point uniformly on it. Le_i is the emissive factor times the mean of the emissive
- * texture; the texture itself is evaluated at the sampled point, so the table only has to be
- * positive wherever emission is (a texture with any non-zero texel has a positive mean).
+ * then a point uniformly on it. Le_i is the triangle's mean radiance (meanTriangleEmission:
+ * the emissive factor times the emissive texture's mean over the triangle's uv footprint),
+ * floored at 1e-3 of the factor times the whole texture's mean; the texture itself is
+ * evaluated at the sampled point, so the table only has to be positive wherever emission is
+ * (a texture with any non-zero texel has a positive mean).
  */
 #include <cstdint>
 #include <vector>

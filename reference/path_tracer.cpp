@@ -42,9 +42,10 @@ bool planeUv(const PrimaryRays& rays, const MeshTriangle& tri, float px, float p
     if (!(std::abs(denom) > 1e-12f)) return false;
     const glm::vec3 q = ray.origin + ray.direction * (glm::dot(tri.n, tri.p0 - ray.origin) / denom);
     const glm::vec3 v = q - tri.p0;
-    const float d00 = glm::dot(tri.e1, tri.e1), d01 = glm::dot(tri.e1, tri.e2);
-    const float d11 = glm::dot(tri.e2, tri.e2);
-    const float d20 = glm::dot(v, tri.e1), d21 = glm::dot(v, tri.e2);
+    const glm::vec3 e1 = tri.e1(), e2 = tri.e2();
+    const float d00 = glm::dot(e1, e1), d01 = glm::dot(e1, e2);
+    const float d11 = glm::dot(e2, e2);
+    const float d20 = glm::dot(v, e1), d21 = glm::dot(v, e2);
     const float det = d00 * d11 - d01 * d01;
     if (!(det > 0.0f)) return false;
     uv = tri.uvAt((d11 * d20 - d01 * d21) / det, (d00 * d21 - d01 * d20) / det);
@@ -149,10 +150,22 @@ const char* estimatorName(Estimator e) {
     return "?";
 }
 
+namespace {
+
+/** The scene moved by -camera.position (RenderSpace::Camera; scene.h translateScene). */
+Scene inRenderSpace(const Scene& s, RenderSpace space) {
+    Scene out = s;
+    if (space == RenderSpace::Camera) translateScene(out, -glm::dvec3(s.camera.position));
+    return out;
+}
+
+}  // namespace
+
 struct PathTracer::Impl {
-    Impl(const Scene& s, const ReferenceSettings& st)
-        : scene((validate(s, st), s)),
+    Impl(const Scene& s, const ReferenceSettings& st, RenderSpace space)
+        : scene((validate(s, st), inRenderSpace(s, space))),
           settings(st),
+          space(space),
           textures(scene.textures, st.pixelFilter == PixelFilter::Center),
           mesh(scene, textures),
           lights(scene, textures, mesh),
@@ -167,6 +180,7 @@ struct PathTracer::Impl {
 
     const Scene scene;  // a copy: the tracer never depends on the caller's lifetime
     const ReferenceSettings settings;
+    const RenderSpace space;
     const TextureLookup textures;
     EmbreeScene mesh;  // non-const only for embree() (benchmarks)
     const LightSampler lights;
@@ -322,8 +336,8 @@ void PathTracer::Impl::renderTile(int tx, int ty, uint64_t first, uint32_t count
     }
 }
 
-PathTracer::PathTracer(const Scene& scene, const ReferenceSettings& settings)
-    : m_impl(std::make_unique<Impl>(scene, settings)) {}
+PathTracer::PathTracer(const Scene& scene, const ReferenceSettings& settings, RenderSpace space)
+    : m_impl(std::make_unique<Impl>(scene, settings, space)) {}
 
 PathTracer::~PathTracer() = default;
 
@@ -435,8 +449,11 @@ std::string PathTracer::toString() const {
         << "seed: " << s.seed << "\n"
         << "pixel filter: " << pixelFilterName(s.pixelFilter) << "\n"
         << "batch_samples: " << s.batchSamples << " (does not change the image)\n"
-        << "ray_offsets: 256 ulps along the geometric normal; fixed step near the origin scaled by "
-           "min(1, scene magnitude)\n"
+        << "ray_origins: exact hit point (double ray-plane), moved off the hit triangle and every "
+           "neighbour within reach by 8x its Embree float-test error bound (reference/spawn.h)\n"
+        << "render_space: "
+        << (im.space == RenderSpace::Camera ? "camera (scene moved by -camera position)\n"
+                                            : "world\n")
         << (s.sampler == SamplerKind::Independent
                 ? "rng: independent uniform, SplitMix64 hash of (seed, pixel, sample, dimension)\n"
                 : "rng: sobol, Owen-scrambled (0,2)-sequence per 1D/2D draw of the first 6, "

@@ -54,8 +54,10 @@ const char* pixelFilterName(PixelFilter f);  // "box", "center"
 /** Bumped whenever a change alters the images; part of every reference cache key.
  *  3: roulette by default, wavefront (issue 16); 4: hit points step back along the arriving ray
  *  (concave edges), the centre filter is 2^-10 px wide and looks the camera hit's textures up
- *  at the rasteriser's mip level (issue 27). */
-inline constexpr int kRendererVersion = 4;
+ *  at the rasteriser's mip level (issue 27); 5: ray origins off every nearby plane by error
+ *  margins instead of steps that grow with |p| (reference/spawn.h), hit points from a double-
+ *  precision plane intersection, emitters picked by their triangles' own mean radiance. */
+inline constexpr int kRendererVersion = 5;
 
 struct ReferenceSettings {
     /** Indirect bounces computed: 0 = emission + direct only; paths have at most
@@ -158,10 +160,20 @@ struct RecordedRay {
 
 class EmbreeScene;
 
+/**
+ * Where the tracer's coordinates have their origin. Camera (default): the scene is moved so the
+ * camera sits at the origin (as pbrt-v4's camera-world rendering space), so the floats are
+ * finest where the image is, and a scene moved by an exact amount renders the same wherever it
+ * sits. World: the scene's own coordinates (tests of the ray offsets far from the origin).
+ * The images do not depend on it beyond float rounding (docs/reference.md, "Ray origins").
+ */
+enum class RenderSpace { Camera, World };
+
 class PathTracer {
 public:
     /** Builds the Embree scene (BVH), light sampling tables and texture lookups. */
-    PathTracer(const Scene& scene, const ReferenceSettings& settings);
+    PathTracer(const Scene& scene, const ReferenceSettings& settings,
+               RenderSpace space = RenderSpace::Camera);
     ~PathTracer();
     PathTracer(const PathTracer&) = delete;
     PathTracer& operator=(const PathTracer&) = delete;
@@ -176,6 +188,7 @@ public:
     const RayStats& stats() const;
     /** Exact description of the settings, embedded in every sidecar. */
     std::string toString() const;
+    /** The scene as traced (moved to the render space). */
     const Scene& scene() const;
     const ReferenceSettings& settings() const;
     /** The Embree scene (for benchmarks). */

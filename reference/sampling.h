@@ -250,36 +250,6 @@ inline float powerHeuristic(float fPdf, float gPdf) {
     return 1.0f / (1.0f + r * r);
 }
 
-/**
- * Moves a point off a surface along the (unit, geometric) normal n by a few hundred ulps of its
- * coordinates, so the offset scales with |p| (Waechter & Binder, "A Fast and Robust Method for
- * Avoiding Self-Intersection", Ray Tracing Gems 2019, ch. 6). Rays then start at t = 0.
- * Near the origin (|p| < originScale / 32) ulps vanish and a fixed step of originScale / 65536
- * is used instead. The chapter's constants assume a scene of about unit size; `originScale` =
- * min(1, the scene's largest coordinate magnitude) (rayOffsetScale) shrinks that step with a
- * scene smaller than a metre: a 1 mm box otherwise gets offsets of 3 % of its size and a biased
- * image (docs/reference.md "Ray offsets", found by `gilab audit`).
- */
-inline glm::vec3 offsetRayOrigin(const glm::vec3& p, const glm::vec3& n, float originScale = 1.0f) {
-    const float kOrigin = originScale / 32.0f;
-    const float kFloatScale = originScale / 65536.0f;
-    constexpr float kIntScale = 256.0f;
-    glm::vec3 out;
-    for (int i = 0; i < 3; ++i) {
-        const int32_t ofs = int32_t(kIntScale * n[i]);
-        const int32_t bits = std::bit_cast<int32_t>(p[i]) + (p[i] < 0.0f ? -ofs : ofs);
-        out[i] = std::abs(p[i]) < kOrigin ? p[i] + kFloatScale * n[i] : std::bit_cast<float>(bits);
-    }
-    return out;
-}
-
-/** offsetRayOrigin's originScale for a scene with these bounds: min(1, max |coordinate|). */
-inline float rayOffsetScale(const glm::vec3& lo, const glm::vec3& hi) {
-    const glm::vec3 m = glm::max(glm::abs(lo), glm::abs(hi));
-    const float magnitude = std::max(m.x, std::max(m.y, m.z));
-    return std::isfinite(magnitude) && magnitude > 0.0f ? std::min(1.0f, magnitude) : 1.0f;
-}
-
 inline bool isFinite(const glm::vec3& v) {
     return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z);
 }

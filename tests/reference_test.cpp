@@ -1178,7 +1178,8 @@ TEST(CpuReferenceStop, DescriptionNamesEverySetting) {
     const std::string version = "v" + std::to_string(kRendererVersion);
     for (const char* part :
          {version.c_str(), "estimator: nee", "max_bounces: 9", "roulette_start_bounce: 3",
-          "seed: 42", "batch_samples: 16", "pixel filter: ", "ray_offsets: ", "embree: 3."})
+          "seed: 42", "batch_samples: 16",
+          "pixel filter: ", "ray_origins: ", "render_space: camera", "embree: 3."})
         EXPECT_NE(d.find(part), std::string::npos) << part << " in\n" << d;
     // One description of the pixel filter, the one in use (it was also a fixed "box" line)
     EXPECT_EQ(d.find("pixel_filter:"), std::string::npos) << d;

@@ -14,6 +14,7 @@
 #include "tests/gpu_test_fixture.h"
 
 #include "core/image/color.h"
+#include "core/scene/mesh_builder.h"
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
 #include "core/technique/registry.h"
@@ -286,6 +287,82 @@ TEST_F(GpuReferenceVsDirect, CornellAreaLightEmissionAgrees) {
         "[ measured ] cornell area light, image-mean direct: GPU (K emitter samples) / "
         "reference = %.4f\n",
         sumGpu / sumRef);
+}
+
+// Two emitter quads cut from one texture of a bright and a dim half (4 x 1 texels, clamped): the
+// left quad's uvs span the bright texels, the right one's the dim texels, so each emits a
+// constant radiance that the texture's mean (the average of both) misstates by +-60 %. The
+// exact area-light irradiance uses each triangle's own mean (core/scene/emission.h); the floor
+// under both must agree with the path tracer to its noise.
+Scene texturedEmitters(int size) {
+    Scene s;
+    s.name = "textured_emitters";
+    s.sourcePath = "<test>";
+    s.settings.width = s.settings.height = size;
+    Texture tex;
+    tex.name = "<bright | dim>";
+    tex.width = 4;
+    tex.height = 1;
+    tex.colorSpace = ColorSpace::Linear;
+    tex.wrapU = tex.wrapV = WrapMode::ClampToEdge;
+    for (uint8_t v : {255, 255, 51, 51})
+        tex.rgba.insert(tex.rgba.end(), {v, v, v, 255});
+    s.textures.push_back(tex);
+    Material floor;
+    floor.baseColorFactor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+    Material light;
+    light.baseColorFactor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    light.emissiveFactor = glm::vec3(4.0f);
+    light.emissiveTexture = 0;
+    s.materials = {floor, light};
+    appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, 0);
+    for (const float u0 : {0.0f, 0.75f}) {
+        const float x0 = u0 == 0.0f ? -0.45f : 0.05f;
+        const size_t first = s.vertices.size();
+        appendQuad(s, {x0, 0.35f, -0.2f}, {x0 + 0.4f, 0.35f, -0.2f}, {x0 + 0.4f, 0.35f, 0.2f},
+                   {x0, 0.35f, 0.2f}, {0, -1, 0}, 1);
+        for (size_t v = first; v < s.vertices.size(); ++v)
+            s.vertices[v].uv.x = u0 + 0.25f * s.vertices[v].uv.x;
+    }
+    s.camera.position = {0.0f, 1.4f, 1.4f};
+    s.camera.target = {0.0f, 0.0f, 0.0f};
+    s.camera.up = {0.0f, 1.0f, 0.0f};
+    s.camera.vfovRad = glm::radians(50.0f);
+    s.computeCaps();
+    return s;
+}
+
+TEST_F(GpuReferenceVsDirect, TexturedEmitterUsesEachTrianglesMeanRadiance) {
+    constexpr int kSize = 48, kFactor = 4;
+    constexpr uint32_t kSpp = 2048;
+    const Scene scene = texturedEmitters(kSize);
+    const auto gpu = renderDirect(*m_ctx, scene, true, kFactor);
+    const auto gpuUnshadowed = renderDirect(*m_ctx, scene, false, kFactor);
+    const ref::Accumulator acc = renderReference(scene, kSpp);
+    const Image refDirect = ref::meanLayers(acc)[int(ref::Layer::Direct)].image;
+    const Image refStdErr = ref::stdErrorLayers(acc)[int(ref::Layer::Direct)].image;
+    const std::vector<uint8_t> keep = comparablePixels(refDirect, gpu, gpuUnshadowed, kFactor);
+    const Image gpuDirect = downsample(layer(gpu, "direct"), kFactor);
+    const Comparison c = compare(refDirect, refStdErr, gpuDirect, keep);
+    // The floor under each emitter: left (bright) and right (dim) halves of the image
+    double left = 0.0, leftRef = 0.0, right = 0.0, rightRef = 0.0;
+    for (int y = 0; y < kSize; ++y)
+        for (int x = 0; x < kSize; ++x) {
+            if (!keep[size_t(y * kSize + x)]) continue;
+            (x < kSize / 2 ? left : right) += lum(gpuDirect, x, y);
+            (x < kSize / 2 ? leftRef : rightRef) += lum(refDirect, x, y);
+        }
+    std::printf(
+        "[ measured ] textured emitters %dx%d, reference %u spp: %d lit pixels compared; "
+        "|rel diff| mean %.2e max %.2e; signed mean %+.2e +- %.1e; outliers %d; "
+        "GPU / reference under the bright quad's side %.4f, the dim one's %.4f\n",
+        kSize, kSize, kSpp, c.lit, c.meanRel, c.maxRel, c.meanSigned, c.signedSigma, c.outliers,
+        left / leftRef, right / rightRef);
+    EXPECT_GT(c.lit, kSize * kSize / 3);
+    EXPECT_LT(std::abs(c.meanSigned), 4.0 * c.signedSigma + 2e-3);
+    EXPECT_NEAR(left / leftRef, 1.0, 0.01);
+    EXPECT_NEAR(right / rightRef, 1.0, 0.01);
+    EXPECT_LE(c.outliers, c.lit / 100);
 }
 
 // ---------------------------------------------------------------------------------------------

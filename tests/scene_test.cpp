@@ -21,6 +21,8 @@
 #include <glm/gtc/constants.hpp>
 #include <nlohmann/json.hpp>
 
+#include "core/scene/emission.h"
+#include "core/scene/mesh_builder.h"
 #include "core/scene/procedural_cornell.h"
 #include "core/scene/procedural_rooms.h"
 #include "core/scene/scene_loader.h"
@@ -973,6 +975,77 @@ TEST(CpuSceneErrors, UnknownKeysAndBadValues) {
           {"albedo.json", "procedural.albedo_scale"});
     check("variantkey.json", "{" + box + R"(, "variants": {"v": {"lihgts": []}}})",
           {"variantkey.json", "variant \"v\"", "\"lihgts\""});
+    check("far.json", "{" + box + R"(, "translate": [0, 2e7, 0]})",
+          {"far.json", "translate", "out of range"});
+    check("translate2.json", "{" + box + R"(, "translate": [0, 1]})",
+          {"translate2.json", "translate"});
+}
+
+// `translate` moves geometry, point/spot lights and the camera after `scale`; directions and
+// directional lights stay (docs/scenes.md)
+TEST(CpuSceneDescription, TranslateMovesEveryPositionAfterScale) {
+    TempDir dir;
+    const std::string path = dir.write("moved.json", R"({
+        "procedural": {"generator": "cornell_box"},
+        "extra_lights": [{"type": "point", "position": [0.1, 0.2, 0.3], "intensity": 1},
+                         {"type": "directional", "direction": [0, -1, 0], "intensity": 1}],
+        "variants": {"moved": {"scale": 2, "translate": [5000, -10, 3000]}}})");
+    const Scene a = loadSceneFile(path);
+    const Scene b = loadSceneFile(path, "moved");
+    ASSERT_EQ(a.vertices.size(), b.vertices.size());
+    const glm::vec3 t(5000.0f, -10.0f, 3000.0f);
+    for (size_t i = 0; i < a.vertices.size(); i += 7)
+        EXPECT_EQ(b.vertices[i].position,
+                  glm::vec3(glm::dvec3(2.0f * a.vertices[i].position) + glm::dvec3(t)));
+    EXPECT_EQ(b.vertices[0].normal, a.vertices[0].normal);
+    const Light& point = b.lights[b.lights.size() - 2];
+    EXPECT_NEAR(point.position.x, 5000.2f, 1e-3f);
+    EXPECT_NEAR(point.position.z, 3000.6f, 1e-3f);
+    EXPECT_EQ(b.lights.back().direction, a.lights.back().direction);
+    EXPECT_NEAR(b.camera.position.x, 2.0f * a.camera.position.x + 5000.0f, 1e-3f);
+    EXPECT_NEAR(b.camera.target.y, 2.0f * a.camera.target.y - 10.0f, 1e-3f);
+    EXPECT_NEAR(b.caps.bounds.lo.x, 2.0f * a.caps.bounds.lo.x + 5000.0f, 1e-3f);
+}
+
+TEST(CpuSceneErrors, TranslateRefusesAnAnimatedScene) {
+    TempDir dir;
+    const std::string path = dir.write("anim.json", R"({
+        "procedural": {"generator": "cornell_box"}, "translate": [1, 0, 0],
+        "animation": {"frames": 2, "tracks": []}})");
+    expectError([&] { loadSceneFile(path); }, {"anim.json", "translate", "animated"});
+}
+
+// A triangle's mean emission over its uv footprint (core/scene/emission.h): exact for a
+// texture that is linear in u (a ramp, clamped), and each half of a quad gets its own mean
+TEST(CpuSceneEmission, TriangleMeanIsTheTexturesMeanOverItsUvFootprint) {
+    Scene s;
+    Texture ramp;
+    ramp.width = 256;
+    ramp.height = 1;
+    ramp.colorSpace = ColorSpace::Linear;
+    ramp.wrapU = ramp.wrapV = WrapMode::ClampToEdge;
+    for (int i = 0; i < 256; ++i)
+        ramp.rgba.insert(ramp.rgba.end(), {uint8_t(i), uint8_t(i), uint8_t(i), 255});
+    s.textures.push_back(ramp);
+    Material m;
+    m.emissiveFactor = glm::vec3(2.0f);
+    m.emissiveTexture = 0;
+    s.materials.push_back(m);
+    // uv (0.25, 0) (0.75, 0) (0.75, 1): the mean u is 7/12; value(u) = (256 u - 0.5) / 255
+    appendQuad(s, {0, 0, 0}, {1, 0, 0}, {1, 0, 1}, {0, 0, 1}, {0, 1, 0}, 0);
+    for (Vertex& v : s.vertices)
+        v.uv.x = 0.25f + 0.5f * v.uv.x;
+    for (size_t t = 0; t < 2; ++t) {
+        glm::vec2 meanUv(0.0f);
+        for (int k = 0; k < 3; ++k)
+            meanUv += s.vertices[s.indices[3 * t + size_t(k)]].uv / 3.0f;
+        const float expected = 2.0f * (256.0f * meanUv.x - 0.5f) / 255.0f;
+        EXPECT_NEAR(meanTriangleEmission(s, t).x, expected, 2e-4f) << "triangle " << t;
+    }
+    EXPECT_GT(std::abs(meanTriangleEmission(s, 0).x - meanTriangleEmission(s, 1).x), 0.3f);
+    // No texture: the factor
+    s.materials[0].emissiveTexture = -1;
+    EXPECT_EQ(meanTriangleEmission(s, 0), glm::vec3(2.0f));
 }
 
 TEST(CpuSceneErrors, UnknownVariantListsTheAvailableOnes) {

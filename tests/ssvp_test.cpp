@@ -459,7 +459,7 @@ TEST_F(GpuSsvp, OwnMapsShadowTheSecondBounceLikeShadowRays) {
         h.renderFrame();
         std::vector<ImageLayer> layers = h.readLayers();
         const nlohmann::ordered_json same =
-            exp::computeSameVplReference(h, scene, layers, ToneMap{});
+            exp::computeSameVplReference(h, h.scene(), layers, ToneMap{});
         Frame f;
         f.indirectMean = same.at("indirect").at("mean").get<double>();
         if (same.at("by_bounce").contains("2"))

@@ -66,6 +66,12 @@ Frame renderOnce(vk::Context& ctx, const Scene& scene,
     f.layers = h.readLayers();
     Image normal, albedo;
     EXPECT_TRUE(h.readVplFrame(f.vpls, f.position, normal, albedo));
+    // The G-buffer is relative to the harness's render origin; the tests think in the scene's.
+    const glm::dvec3 o = h.renderOrigin();
+    for (int y = 0; y < f.position.height(); ++y)
+        for (int x = 0; x < f.position.width(); ++x)
+            for (int c = 0; c < 3; ++c)
+                f.position.at(x, y, c) = float(double(f.position.at(x, y, c)) + o[c]);
     return f;
 }
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/scene/emission.h"
 #include "core/scene/scene.h"
 
 namespace gilab {
@@ -14,6 +15,7 @@ struct EmitterTriangle {
     glm::vec2 uv0{0.0f}, uv1{0.0f}, uv2{0.0f};
     glm::vec3 normal{0.0f};
     float area = 0.0f;
+    glm::vec3 meanRadiance{0.0f};  // over the triangle (its emissive texture's footprint)
     double power = 0.0;
     const Material* material = nullptr;
 };
@@ -22,57 +24,10 @@ float luminance(const glm::vec3& c) {
     return 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
 }
 
-float srgbToLinear(float c) {
-    return c <= 0.04045f ? c / 12.92f : std::pow((c + 0.055f) / 1.055f, 2.4f);
-}
-
-float wrapCoord(float t, WrapMode mode) {
-    switch (mode) {
-        case WrapMode::ClampToEdge:
-            return std::clamp(t, 0.0f, 1.0f);
-        case WrapMode::MirroredRepeat: {
-            float m = t - 2.0f * std::floor(0.5f * t);
-            return m > 1.0f ? 2.0f - m : m;
-        }
-        case WrapMode::Repeat:
-            break;
-    }
-    return t - std::floor(t);
-}
-
-/** Nearest texel, decoded to linear (the GPU filters bilinearly; the difference is sub-texel). */
-glm::vec3 lookupTexture(const Texture& tex, glm::vec2 uv) {
-    if (tex.width <= 0 || tex.height <= 0) return glm::vec3(1.0f);
-    float u = wrapCoord(uv.x, tex.wrapU), v = wrapCoord(uv.y, tex.wrapV);
-    int x = std::clamp(int(u * float(tex.width)), 0, tex.width - 1);
-    int y = std::clamp(int(v * float(tex.height)), 0, tex.height - 1);
-    const uint8_t* t = &tex.rgba[(size_t(y) * size_t(tex.width) + size_t(x)) * 4];
-    glm::vec3 c(t[0] / 255.0f, t[1] / 255.0f, t[2] / 255.0f);
-    if (tex.colorSpace == ColorSpace::Srgb) {
-        c = glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
-    }
-    return c;
-}
-
-/** Mean of the texture's texels, decoded to linear. */
-glm::vec3 textureMean(const Texture& tex) {
-    if (tex.width <= 0 || tex.height <= 0) return glm::vec3(1.0f);
-    glm::dvec3 sum(0.0);
-    const size_t n = size_t(tex.width) * size_t(tex.height);
-    for (size_t i = 0; i < n; ++i) {
-        glm::vec3 c(tex.rgba[4 * i] / 255.0f, tex.rgba[4 * i + 1] / 255.0f,
-                    tex.rgba[4 * i + 2] / 255.0f);
-        if (tex.colorSpace == ColorSpace::Srgb)
-            c = glm::vec3(srgbToLinear(c.r), srgbToLinear(c.g), srgbToLinear(c.b));
-        sum += glm::dvec3(c);
-    }
-    return glm::vec3(sum / double(n));
-}
-
 glm::vec3 emittedRadiance(const Scene& scene, const Material& m, glm::vec2 uv) {
     glm::vec3 le = m.emissiveFactor;
     if (m.emissiveTexture >= 0 && size_t(m.emissiveTexture) < scene.textures.size()) {
-        le *= lookupTexture(scene.textures[size_t(m.emissiveTexture)], uv);
+        le *= bilinearLinear(scene.textures[size_t(m.emissiveTexture)], uv);
     }
     return le;
 }
@@ -104,7 +59,8 @@ std::vector<EmitterTriangle> collectEmitters(const Scene& scene) {
         e.normal = c / len;
         e.area = 0.5f * len;
         e.material = &m;
-        e.power = double(luminance(m.emissiveFactor)) * e.area * (m.doubleSided ? 2.0 : 1.0);
+        e.meanRadiance = meanTriangleEmission(scene, t);
+        e.power = double(luminance(e.meanRadiance)) * e.area * (m.doubleSided ? 2.0 : 1.0);
         if (e.power > 0.0) out.push_back(e);
     }
     return out;
@@ -118,18 +74,11 @@ size_t countEmitterTriangles(const Scene& scene) {
 
 std::vector<EmitterPolygon> buildEmitterPolygons(const Scene& scene) {
     std::vector<EmitterPolygon> out;
-    std::vector<glm::vec3> textureMeans(scene.textures.size(), glm::vec3(-1.0f));
     for (const EmitterTriangle& e : collectEmitters(scene)) {
         EmitterPolygon p;
         p.p0 = e.p0, p.p1 = e.p1, p.p2 = e.p2;
         p.twoSided = e.material->doubleSided;
-        p.radiance = e.material->emissiveFactor;
-        const int t = e.material->emissiveTexture;
-        if (t >= 0 && size_t(t) < scene.textures.size()) {
-            glm::vec3& mean = textureMeans[size_t(t)];
-            if (mean.x < 0.0f) mean = textureMean(scene.textures[size_t(t)]);
-            p.radiance *= mean;
-        }
+        p.radiance = e.meanRadiance;
         out.push_back(p);
     }
     return out;

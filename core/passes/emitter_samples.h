@@ -12,7 +12,8 @@
  * which converges to the exact area light as K -> infinity.
  *
  * Allocation (deterministic): the K samples are stratified over the emissive triangles by power
- * Phi_i = luminance(Le_i) * area_i (x 2 when double-sided): sample k goes to the triangle whose
+ * Phi_i = luminance(Le_i) * area_i (x 2 when double-sided), Le_i the triangle's mean radiance
+ * (meanTriangleEmission, core/scene/emission.h): sample k goes to the triangle whose
  * cumulative power share contains (k + 0.5) / K. A triangle with n_i samples places them at n_i
  * Hammersley points warped uniformly onto it, each with A_k = area_i / n_i, so every sampled
  * triangle keeps its power exactly. Triangles that get no sample (power share < 1/K) have their
@@ -39,7 +40,8 @@ struct EmitterSample {
 /**
  * An emissive triangle for the direct pass's exact unoccluded irradiance (Lambert's polygon
  * formula, docs/shared_passes.md "Area lights"): its vertices (counter-clockwise), its radiance
- * (emissive factor x the mean of its emissive texture) and whether both faces emit.
+ * (emissive factor x the mean of its emissive texture over the triangle's uv footprint) and
+ * whether both faces emit.
  */
 struct EmitterPolygon {
     glm::vec3 p0{0.0f}, p1{0.0f}, p2{0.0f};

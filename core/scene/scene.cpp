@@ -44,4 +44,24 @@ void Scene::computeCaps() {
     }
 }
 
+void translateScene(Scene& scene, const glm::dvec3& t) {
+    auto moved = [&](const glm::vec3& p) { return glm::vec3(glm::dvec3(p) + t); };
+    for (Vertex& v : scene.vertices)
+        v.position = moved(v.position);
+    for (Light& l : scene.lights)
+        if (l.type != LightType::Directional) l.position = moved(l.position);
+    scene.camera.position = moved(scene.camera.position);
+    scene.camera.target = moved(scene.camera.target);
+    scene.computeCaps();
+}
+
+glm::dvec3 renderOrigin(const Scene& scene) {
+    const Bounds& b = scene.caps.bounds;
+    if (!b.valid()) return glm::dvec3(0.0);
+    const glm::dvec3 centre = 0.5 * (glm::dvec3(b.lo) + glm::dvec3(b.hi));
+    const glm::dvec3 origin = glm::round(centre);
+    const bool finite = !glm::any(glm::isnan(origin)) && !glm::any(glm::isinf(origin));
+    return finite ? origin : glm::dvec3(0.0);
+}
+
 }  // namespace gilab

@@ -147,4 +147,15 @@ struct Scene {
     void computeCaps();
 };
 
+/**
+ * Moves every position by t, in double and rounded once (so a move by an amount the floats can
+ * hold exactly comes back bit for bit): vertices, point and spot lights, the camera's position
+ * and target; `caps` recomputed. Directions, radiometry and the animation's keys are kept.
+ */
+void translateScene(Scene& scene, const glm::dvec3& t);
+
+/** Where the rasteriser's passes put the origin: the centre of the scene's bounds rounded to
+ *  whole metres (so a scene moved by whole metres is moved back exactly), 0 without bounds. */
+glm::dvec3 renderOrigin(const Scene& scene);
+
 }  // namespace gilab

@@ -332,7 +332,7 @@ Light parseLight(const JsonNode& node) {
 
 SceneDescription parseSceneDescription(const JsonNode& root, const std::string& baseDir) {
     root.expectKeys({"name", "gltf", "procedural", "camera", "resolution", "exposure_ev", "lights",
-                     "extra_lights", "material_overrides", "remove_emissive", "scale",
+                     "extra_lights", "material_overrides", "remove_emissive", "scale", "translate",
                      "animation"});
     SceneDescription d;
     d.context = root.context();
@@ -386,6 +386,17 @@ SceneDescription parseSceneDescription(const JsonNode& root, const std::string& 
         if (root.has("animation") && d.scale != 1.0)
             root["scale"].fail(
                 "cannot scale an animated scene (its keys are in the unscaled units)");
+    }
+    if (root.has("translate")) {
+        const JsonNode t = root["translate"];
+        const glm::vec3 v = t.vec3();
+        for (int i = 0; i < 3; ++i)
+            if (!(std::abs(double(v[i])) <= 1e7))
+                t.fail("out of range: every component must be in [-1e7, 1e7] (got " +
+                       std::to_string(v[i]) + ")");
+        if (root.has("animation") && v != glm::vec3(0.0f))
+            t.fail("cannot translate an animated scene (its keys are in the untranslated frame)");
+        d.translate = glm::dvec3(v);
     }
     if (root.has("animation")) d.animation = parseAnimation(root["animation"]);
     return d;

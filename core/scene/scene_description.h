@@ -60,6 +60,9 @@ struct SceneDescription {
     bool removeEmissive = false;
     /** Uniform scale of every length (geometry, camera, light positions; docs/scenes.md). */
     double scale = 1.0;
+    /** Added to every position after `scale` (geometry, camera, point/spot lights; docs/scenes.md).
+     */
+    glm::dvec3 translate{0.0};
     std::optional<AnimationDescription> animation;
 };
 

@@ -139,6 +139,7 @@ Scene buildScene(const SceneDescription& d) {
     scene.computeCaps();  // bounds for a framing camera
     applyCamera(scene, d, hasCamera);
     if (d.scale != 1.0) applyScale(scene, d.scale);
+    if (d.translate != glm::dvec3(0.0)) translateScene(scene, d.translate);
     if (d.resolution) {
         scene.settings.width = d.resolution->x;
         scene.settings.height = d.resolution->y;

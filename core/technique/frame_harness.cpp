@@ -48,6 +48,7 @@ Image readImage(vk::Context& ctx, vk::Image& image, int channels) {
 FrameHarness::FrameHarness(vk::Context& ctx, const Scene& scene, const std::string& techniqueId,
                            const ParamSet& techniqueParams, const ParamSet& sharedParams)
     : m_ctx(ctx),
+      m_renderOrigin(gilab::renderOrigin(scene)),
       m_scene(scene),
       m_technique(TechniqueRegistry::instance().create(techniqueId)),
       m_params(techniqueParams),
@@ -55,6 +56,7 @@ FrameHarness::FrameHarness(vk::Context& ctx, const Scene& scene, const std::stri
     if (m_params.owner() != techniqueId)
         throw Error("parameters of \"" + m_params.owner() + "\" given to technique \"" +
                     techniqueId + "\"");
+    if (m_renderOrigin != glm::dvec3(0.0)) translateScene(m_scene, -m_renderOrigin);
     m_support = m_technique->checkSupport(scene, m_params);
     if (scene.triangleCount() == 0) m_support = {false, "the scene has no triangles"};
     if (scene.settings.width < 1 || scene.settings.height < 1)
@@ -130,10 +132,17 @@ SetupTiming FrameHarness::setup() {
     return t;
 }
 
-SceneChanges FrameHarness::setFrameState(const SceneFrameState& state) {
-    if (state.lights.size() != m_scene.lights.size())
-        throw Error("setFrameState: " + std::to_string(state.lights.size()) +
+SceneChanges FrameHarness::setFrameState(const SceneFrameState& worldState) {
+    if (worldState.lights.size() != m_scene.lights.size())
+        throw Error("setFrameState: " + std::to_string(worldState.lights.size()) +
                     " lights for a scene with " + std::to_string(m_scene.lights.size()));
+    // Into the passes' coordinates (as the constructor moved the scene)
+    SceneFrameState state = worldState;
+    auto moved = [&](const glm::vec3& p) { return glm::vec3(glm::dvec3(p) - m_renderOrigin); };
+    for (Light& l : state.lights)
+        if (l.type != LightType::Directional) l.position = moved(l.position);
+    state.camera.position = moved(state.camera.position);
+    state.camera.target = moved(state.camera.target);
     const SceneChanges changes =
         diffFrameStates(SceneFrameState{m_scene.lights, m_scene.camera}, state);
     applyFrameState(m_scene, state);

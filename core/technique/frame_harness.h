@@ -80,7 +80,8 @@ public:
     /** Throws gilab::Error if the technique does not support the scene. */
     SetupTiming setup();
     /**
-     * Moves the scene to `state` (lights, camera: a frame of its animation). The changes are
+     * Moves the scene to `state` (lights, camera: a frame of its animation, in world
+     * coordinates; moved by -renderOrigin() here). The changes are
      * applied by the next renderFrame(), which is then a dynamic frame. Returns what changed
      * (accumulated with changes not rendered yet).
      */
@@ -93,8 +94,12 @@ public:
      */
     WarmupResult warmUp(int frames, const std::function<void(int)>& onFrame = {});
     static constexpr int kMaxWarmupFrames = 64;
-    /** The scene as it is now (the harness's own copy; animated frames change it). */
+    /** The scene as it is now (the harness's own copy; animated frames change it), moved by
+     *  -renderOrigin(): every pass and technique works in these coordinates. */
     const Scene& scene() const { return m_scene; }
+    /** The world position of the passes' origin (scene.h renderOrigin: the bounds' centre in
+     *  whole metres), so a scene far from the world's origin keeps the floats' precision. */
+    const glm::dvec3& renderOrigin() const { return m_renderOrigin; }
     /** Frames without timestamp queries (to measure the instrumentation's own cost). */
     void setTimestampsEnabled(bool enabled) { m_timestamps = enabled; }
     /** Changes technique parameters between frames; calls onParamsChanged with changed keys. */
@@ -105,7 +110,8 @@ public:
 
     /**
      * A VPL technique's last frame for the same-VPL reference: its VPL set and the G-buffer's
-     * world position (xyzw), shading normal and albedo. False when the technique has no VPLs.
+     * position (xyzw, in scene()'s coordinates), shading normal and albedo. False when the
+     * technique has no VPLs.
      */
     bool readVplFrame(VplSet& vpls, Image& position, Image& normal, Image& albedo);
 
@@ -119,7 +125,8 @@ private:
     TechniqueContext makeContext();
 
     vk::Context& m_ctx;
-    Scene m_scene;  // own copy: setFrameState moves its lights and camera
+    glm::dvec3 m_renderOrigin{0.0};
+    Scene m_scene;  // own copy, moved by -m_renderOrigin: setFrameState moves its lights, camera
     SceneChanges m_pending;
     std::unique_ptr<Technique> m_technique;
     ParamSet m_params;

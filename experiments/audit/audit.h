@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <glm/glm.hpp>
 #include <nlohmann/json.hpp>
 
 namespace gilab::audit {
@@ -46,9 +47,16 @@ struct AuditCase {
     /** A documented failure of the techniques this case probes (e.g. light leaking through walls
      *  thinner than a voxel): an energy excess here is amber with this text, not red. */
     std::string documentedFailure;
-    /** Scale cases: the same scene at another scale; "" for the reference scale of the group. */
+    /** Scale cases: the same scene at another scale or place; "" for the reference scale of
+     *  the group. */
     std::string scaleGroup;
     bool scaleBase = false;
+    /** Image size for this case instead of the profile's (the translated boxes: a pixel that
+     *  flips at an edge must not weigh more than the tolerance). */
+    std::optional<glm::ivec2> resolution;
+    /** Green while |mean / the base's - 1| stays below this (the thresholds' scaleGreen when
+     *  unset); the translated boxes ask for 0.2 %. */
+    std::optional<double> scaleTolerance;
 };
 
 struct Catalog {
@@ -78,6 +86,10 @@ struct CellResult {
     std::optional<double> clampedPercent;   // energy a near-VPL clamp removed
     std::optional<double> leak;             // dark cases: mean final / leakScale's mean
     std::optional<double> scaleRatio;       // scale cases: mean final / the group's base
+    /** Scale cases: scaleRatio over the path tracer's own ratio between the two scenes, so a
+     *  change of the scene itself (a box moved 20 km out is stored in 2 mm steps) is not
+     *  charged to the technique; graded. */
+    std::optional<double> scaleVsReference;
     double meanLuminance = 0.0;
     double setupMs = 0.0, frameMs = 0.0;
     double peakMemoryMiB = 0.0;

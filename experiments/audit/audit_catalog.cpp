@@ -87,7 +87,7 @@ Catalog loadCatalog(const std::string& path) {
         const JsonNode n = cases.item(i);
         n.expectKeys({"name", "what", "scene", "quick", "max_bounces", "roulette_start_bounce",
                       "params", "parameter_case", "leak_scale", "scale_group", "scale_base",
-                      "documented_failure"});
+                      "scale_tolerance", "resolution", "documented_failure"});
         AuditCase a;
         a.name = n["name"].string();
         if (a.name.empty() ||
@@ -109,6 +109,15 @@ Catalog loadCatalog(const std::string& path) {
         if (n.has("scale_group")) a.scaleGroup = n["scale_group"].string();
         a.scaleBase = booleanOr(n, "scale_base", false);
         if (a.scaleBase && a.scaleGroup.empty()) n["scale_base"].fail("needs \"scale_group\"");
+        if (n.has("resolution")) {
+            const JsonNode r = n["resolution"];
+            if (r.arraySize() != 2) r.fail("expected [width, height]");
+            a.resolution = glm::ivec2(r.item(0).integerIn(1, 4096), r.item(1).integerIn(1, 4096));
+        }
+        if (n.has("scale_tolerance")) {
+            a.scaleTolerance = n["scale_tolerance"].numberIn(1e-6, 0.1);
+            if (a.scaleGroup.empty()) n["scale_tolerance"].fail("needs \"scale_group\"");
+        }
         c.cases.push_back(std::move(a));
     }
     std::map<std::string, int> bases;

@@ -67,7 +67,9 @@ Json cellConfig(const CellRequest& r, const std::string& name) {
     if (!shared.empty()) technique["shared"] = shared;
     return {{"name", name},
             {"description", "gilab audit: " + r.c.name + " (" + r.c.what + ") x " + r.technique},
-            {"resolution", {r.profile.width, r.profile.height}},
+            {"resolution",
+             {r.c.resolution ? r.c.resolution->x : r.profile.width,
+              r.c.resolution ? r.c.resolution->y : r.profile.height}},
             {"scenes", {r.c.scene}},
             {"reference", referenceJson(r.c, r.profile)},
             {"timing", {{"warmup", r.profile.warmupFrames}, {"frames", r.profile.frames}}},

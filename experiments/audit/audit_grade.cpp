@@ -120,11 +120,19 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
     if (cell.leak && *cell.leak > t.leakAmber)
         v.add(Grade::Amber, fmt("leak: %.2f %% of the lit view's mean", 100.0 * *cell.leak));
     if (cell.scaleRatio) {
-        const double d = std::abs(*cell.scaleRatio - 1.0);
+        // Against the path tracer's own change between the two scenes when it is known
+        const double ratio = cell.scaleVsReference.value_or(*cell.scaleRatio);
+        const double d = std::abs(ratio - 1.0);
+        const double green = c.scaleTolerance.value_or(t.scaleGreen);
+        const std::string what =
+            fmt("mean %.5g x the group's base case", *cell.scaleRatio) +
+            (cell.scaleVsReference
+                 ? fmt(", %.5g x the path tracer's change between them", *cell.scaleVsReference)
+                 : std::string());
         if (!(d <= t.scaleRed))
-            v.add(Grade::Red, fmt("mean %.4g x the same box at 1 m scale", *cell.scaleRatio));
-        else if (d > t.scaleGreen)
-            v.add(Grade::Amber, fmt("mean %.4g x the same box at 1 m scale", *cell.scaleRatio));
+            v.add(Grade::Red, what);
+        else if (d > green)
+            v.add(Grade::Amber, what + fmt(" (green within %.2g %%)", 100.0 * green));
     }
     cell.grade = v.grade;
     cell.reason = v.reasons;

@@ -32,6 +32,7 @@ std::string cellLabel(const CellResult& c) {
     if (c.nanPixels + c.infPixels + c.negativePixels > 0) return s + " nonfinite";
     if (c.validationMessages > 0) return s + " validation";
     if (c.scaleRatio) s += " x" + fmt("%.4f", *c.scaleRatio);
+    if (c.scaleVsReference) s += " r" + fmt("%.4f", *c.scaleVsReference);
     if (c.energyRatio) s += " e" + fmt("%.2f", *c.energyRatio);
     if (c.leak) s += " leak " + fmt("%.2g%%", 100.0 * *c.leak);
     if (c.peakRatio && *c.peakRatio > 4.0) s += " p" + fmt("%.3g", *c.peakRatio);
@@ -117,6 +118,7 @@ Json auditJson(const AuditSummary& s, const AuditOptions& o, const Catalog& cata
                          {"clamped_energy_percent", optional(c.clampedPercent)},
                          {"leak", optional(c.leak)},
                          {"scale_ratio", optional(c.scaleRatio)},
+                         {"scale_vs_reference", optional(c.scaleVsReference)},
                          {"mean_luminance", c.meanLuminance},
                          {"setup_ms", c.setupMs},
                          {"frame_ms", c.frameMs},

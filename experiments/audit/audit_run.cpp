@@ -76,12 +76,17 @@ void compareScales(AuditSummary& s, const std::vector<const AuditCase*>& cases) 
                 r.scaleZ = se > 0.0 ? std::abs(r.meanLuminance - baseRef->meanLuminance) / se : 0.0;
                 gradeReference(r);
             }
+            const ReferenceResult* otherRef = nullptr;
+            for (const ReferenceResult& r : s.references)
+                if (r.caseName == other->name && r.scaleRatio) otherRef = &r;
             for (CellResult& c : s.cells) {
                 if (c.caseName != other->name || c.outcome != "ok") continue;
                 for (const CellResult& b : s.cells)
                     if (b.caseName == base->name && b.technique == c.technique &&
                         b.outcome == "ok" && b.meanLuminance > 0.0)
                         c.scaleRatio = c.meanLuminance / b.meanLuminance;
+                if (c.scaleRatio && otherRef && *otherRef->scaleRatio > 0.0)
+                    c.scaleVsReference = *c.scaleRatio / *otherRef->scaleRatio;
                 gradeCell(c, *other);
             }
         }
