@@ -105,14 +105,7 @@ BlockAgreement compareBlocks(const Accumulator& a, const Accumulator& b, Layer l
  *  between the two is the renderer's, not the 0.5 mm steps the move put into the scene. */
 Scene movedBack(const Scene& far, const glm::dvec3& t) {
     Scene s = far;
-    auto back = [&](const glm::vec3& p) { return glm::vec3(glm::dvec3(p) - t); };
-    for (Vertex& v : s.vertices)
-        v.position = back(v.position);
-    for (Light& l : s.lights)
-        if (l.type != LightType::Directional) l.position = back(l.position);
-    s.camera.position = back(s.camera.position);
-    s.camera.target = back(s.camera.target);
-    s.computeCaps();
+    translateScene(s, -t);
     return s;
 }
 
