@@ -159,10 +159,13 @@ TEST_F(GpuCvgi, SpotCornellIndirectEnergyAgainstTheOneBounceReference) {
     const double reference = test::oneBounceReferenceSum(scene, 256);
     ASSERT_GT(reference, 0.0);
     const EnergyCase cases[] = {
-        {"paper", "32", "1024", 0.85, 1.1},
-        {"paper", "64", "128", 0.2, 0.7},  // the paper's sampling loss, reproduced
-        {"ray_weighted", "32", "128", 0.9, 1.12},
-        {"ray_weighted", "64", "128", 0.9, 1.12},
+        // Measured (issue 43, stratum-centre directions): 0.918, 0.462, 1.014, 1.008. The bands
+        // are about +-7 % around them (the reference's own noise is below 1 %): the paper's
+        // sampling loss at 64^3 reproduced, not a factor 3.5 either way.
+        {"paper", "32", "1024", 0.87, 0.98},
+        {"paper", "64", "128", 0.43, 0.50},  // the paper's sampling loss, reproduced
+        {"ray_weighted", "32", "128", 0.96, 1.05},
+        {"ray_weighted", "64", "128", 0.96, 1.05},
     };
     for (const EnergyCase& c : cases) {
         FrameHarness h(*m_ctx, scene, "cvgi",
@@ -212,21 +215,26 @@ TEST_F(GpuCvgi, GaussianDoesNotSpreadLightThroughAClosedWall) {
         std::string(GILAB_SOURCE_DIR) + "/scenes/stress/two_rooms_door.json", "room_b_closed");
     scene.settings.width = 32;
     scene.settings.height = 32;
-    auto darkRoomLight = [&](const char* visibility) {
+    auto darkRoomLight = [&](const char* visibility, const char* passes) {
         FrameHarness h(*m_ctx, scene, "cvgi",
                        cvgiParams({{"voxel_resolution", "64"},
                                    {"rays_per_face", "32"},
+                                   {"gaussian_passes", passes},
                                    {"gaussian_visibility", visibility}}),
                        defaultSharedParams());
         h.setup();
         h.renderFrame();
         return test::indirectLayerSum(h.readLayers());
     };
-    const double paperFilter = darkRoomLight("false"), ours = darkRoomLight("true");
-    std::printf("indirect light in the closed room: paper filter %.4g, ours %.4g\n", paperFilter,
-                ours);
-    EXPECT_GT(paperFilter, 0.0);         // the leak this guards against
-    EXPECT_LT(ours, 0.3 * paperFilter);  // measured 0.17 at 64x64 (4.8 % vs 28 % of room B lit)
+    // The control: no filter at all. What room B gets then comes through the gather itself (a
+    // 0.02 m wall is about one 64^3 voxel); the filter must add nothing to it.
+    const double unfiltered = darkRoomLight("true", "0");
+    const double paperFilter = darkRoomLight("false", "2"), ours = darkRoomLight("true", "2");
+    std::printf(
+        "indirect light in the closed room: unfiltered %.4g, paper filter %.4g, ours %.4g\n",
+        unfiltered, paperFilter, ours);
+    EXPECT_GT(paperFilter, 2.0 * unfiltered);  // the leak this guards against
+    EXPECT_LE(ours, 1.02 * unfiltered + 1e-6 * paperFilter);
 }
 
 // Bad input (issue 28): a wide frame asks for a camera distance map wider than the device allows;

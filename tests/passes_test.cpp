@@ -815,6 +815,57 @@ TEST_F(GpuPassesTest, AreaLightConvergesToFormFactor) {
     EXPECT_GT(emitterPixels, 100);
 }
 
+// Horizon clipping (issue 43: the test above never crosses a receiver's plane): an emitter
+// standing through the floor, x = 0.5, y in [-0.25, 0.5], facing -x. Floor points near the centre
+// see only its part above y = 0; Lambert's formula over the whole quad counts the part below the
+// horizon too (the shader clips each triangle to x's tangent plane). Reference: the irradiance of
+// the clipped rectangle by a 400 x 400 midpoint rule.
+TEST_F(GpuPassesTest, AreaLightAcrossTheHorizonIsClipped) {
+    const float lo = -0.25f, hi = 0.5f, wall = 0.5f, halfZ = 0.25f;
+    const glm::vec3 le(2.0f, 3.0f, 4.0f);
+    Scene s = planeScene();
+    Material e = diffuse(glm::vec3(0.0f));
+    e.emissiveFactor = le;
+    s.materials.push_back(e);
+    appendQuad(s, {wall, lo, -halfZ}, {wall, lo, halfZ}, {wall, hi, halfZ}, {wall, hi, -halfZ},
+               {-1.0f, 0.0f, 0.0f}, 1);
+    const Camera cam = lookAt({-1.5f, 0.6f, 0.0f}, {0.0f, 0.0f, 0.0f});
+    // E / Le = integral over the emitter above y = 0 of cos(receiver) cos(emitter) / r^2 dA.
+    auto clippedIntegral = [&](const glm::vec3& p) {
+        const int n = 400;
+        const double dy = double(hi) / n, dz = 2.0 * double(halfZ) / n;
+        double sum = 0.0;
+        for (int i = 0; i < n; ++i)
+            for (int j = 0; j < n; ++j) {
+                const glm::dvec3 q(wall, (i + 0.5) * dy, -halfZ + (j + 0.5) * dz);
+                const glm::dvec3 d = q - glm::dvec3(p);
+                const double r2 = glm::dot(d, d);
+                sum += (d.y / std::sqrt(r2)) * (d.x / std::sqrt(r2)) / r2 * dy * dz;
+            }
+        return sum;
+    };
+    SharedPassSettings settings;
+    settings.areaLightSamples = 16;
+    settings.areaLightAnalytic = true;
+    Frame f = render(s, cam, settings);
+    float maxErr = 0.0f;
+    int checked = 0;
+    for (uint32_t y = 0; y < f.height; y += 3) {
+        for (uint32_t x = 0; x < f.width; x += 3) {
+            if (!onPlane(f, x, y)) continue;
+            const glm::vec3 p(f.at(f.position, x, y));
+            if (std::abs(p.x) > 0.2f || std::abs(p.z) > 0.2f) continue;
+            const glm::vec3 want = le * float(clippedIntegral(p));
+            maxErr = std::max(maxErr, relError(measuredIrradiance(f, x, y), want));
+            ++checked;
+        }
+    }
+    std::printf("emitter across the horizon: %d px near the centre, max relative error %.3g\n",
+                checked, maxErr);
+    EXPECT_GE(checked, 8);
+    EXPECT_LT(maxErr, 2e-3f);
+}
+
 TEST(CpuEmitterSamples, ConservePowerAndStratify) {
     Scene s = planeScene();
     Material e = diffuse(glm::vec3(0.0f));
@@ -1038,24 +1089,97 @@ TEST(CpuShadowCascades, EachCascadeHoldsItsSliceInsideTheScene) {
     EXPECT_NEAR(clip.z, 1.0f - d / (2.0f * frame.radius), 1e-5f);
 }
 
+// Stable cascades (issue 43): the camera moves by sub-texel steps (a tenth of cascade 0's texel,
+// along its right, up and forward axes); every cascade keeps its texel size, and fixed world
+// points keep their position inside their texel, so the same texels are rendered and looked up
+// and the direct light at a fixed point does not change. Refit exactly (snap off), the
+// fractions move with the camera: shadow edges crawl.
+TEST(CpuShadowCascades, SubTexelCameraMovesKeepEveryTexelInPlace) {
+    using namespace cascades_test;
+    const Bounds scene = box({-15.0f, 0.0f, -7.0f}, {15.0f, 13.0f, 7.0f});  // Sponza-like
+    Camera cam;
+    cam.position = {-11.0f, 2.5f, 1.0f};
+    cam.target = {0.0f, 3.5f, -0.5f};
+    cam.vfovRad = glm::radians(55.0f);
+    cam.nearZ = 0.05f;
+    cam.farZ = 200.0f;
+    const float aspect = 16.0f / 9.0f;
+    const OrthoLightFrame frame = frameFor(scene, {0.1f, -1.0f, 0.2f});
+    const glm::vec3 points[] = {
+        {-9.0f, 0.0f, 2.0f}, {-5.0f, 1.0f, -3.0f}, {0.0f, 0.0f, 0.0f}, {6.0f, 4.0f, 5.0f}};
+    auto texelOf = [](const ShadowCascade& c, const glm::vec3& p, uint32_t res) {
+        const glm::vec4 clip = c.viewProj * glm::vec4(p, 1.0f);
+        return (0.5f * glm::vec2(clip) + 0.5f) * float(res);
+    };
+    for (bool snap : {true, false}) {
+        CascadeSettings settings;
+        settings.count = 4;
+        settings.snap = snap;
+        const std::vector<ShadowCascade> c0 =
+            fitShadowCascades(cam, aspect, scene, frame, settings);
+        float worstFraction = 0.0f, worstSize = 0.0f;
+        for (int k = 1; k <= 6; ++k) {
+            Camera moved = cam;
+            const glm::vec3 axis = k % 3 == 0   ? cam.forward()
+                                   : k % 3 == 1 ? cam.right()
+                                                : cam.trueUp();
+            const glm::vec3 step = axis * (0.1f * float(k) * c0[0].texel);
+            moved.position += step;
+            moved.target += step;
+            const std::vector<ShadowCascade> c =
+                fitShadowCascades(moved, aspect, scene, frame, settings);
+            ASSERT_EQ(c.size(), c0.size());
+            for (size_t i = 0; i < c.size(); ++i) {
+                worstSize = std::max(worstSize, std::abs(c[i].texel / c0[i].texel - 1.0f));
+                for (const glm::vec3& p : points) {
+                    const glm::vec2 d = texelOf(c[i], p, settings.resolution) -
+                                        texelOf(c0[i], p, settings.resolution);
+                    const glm::vec2 off = glm::abs(d - glm::round(d));
+                    worstFraction = std::max(worstFraction, std::max(off.x, off.y));
+                }
+            }
+        }
+        std::printf(
+            "snap %d: sub-texel camera moves shift the texel grid by up to %.4f texel, "
+            "texel sizes by %.2g\n",
+            int(snap), worstFraction, worstSize);
+        if (snap) {
+            EXPECT_LT(worstFraction, 2e-3f);
+            EXPECT_LT(worstSize, 1e-6f);
+        } else {
+            EXPECT_GT(worstFraction, 0.02f);  // the defect this guards against
+        }
+    }
+}
+
 TEST(CpuShadowCascades, CameraSeeingNoSceneGetsTheWholeBox) {
     using namespace cascades_test;
     const Bounds scene = box({-1.0f, 0.0f, -1.0f}, {1.0f, 2.0f, 1.0f});
     Camera cam;
     cam.position = {0.0f, 1.0f, 5.0f};
     cam.target = {0.0f, 1.0f, 10.0f};  // looking away
-    const OrthoLightFrame frame = frameFor(scene, {0.0f, -1.0f, 0.0f});
     CascadeSettings settings;
     settings.count = 3;
-    const std::vector<ShadowCascade> c = fitShadowCascades(cam, 1.0f, scene, frame, settings);
-    ASSERT_EQ(c.size(), 3u);
-    for (const ShadowCascade& s : c) {
-        for (const glm::vec3& corner : {scene.lo, scene.hi}) {
-            const glm::vec4 clip = s.viewProj * glm::vec4(corner, 1.0f);
-            EXPECT_LE(std::abs(clip.x), 1.0f);
-            EXPECT_LE(std::abs(clip.y), 1.0f);
+    // Every one of the box's 8 corners, in x, y and depth, for a vertical and a slanted light
+    // (issue 43: two opposite corners under a vertical light were all it checked).
+    for (const glm::vec3& dir : {glm::vec3(0.0f, -1.0f, 0.0f), glm::vec3(0.5f, -1.0f, 0.3f)}) {
+        const OrthoLightFrame frame = frameFor(scene, dir);
+        const std::vector<ShadowCascade> c = fitShadowCascades(cam, 1.0f, scene, frame, settings);
+        ASSERT_EQ(c.size(), 3u);
+        for (const ShadowCascade& s : c) {
+            for (int k = 0; k < 8; ++k) {
+                const glm::vec3 corner(k & 1 ? scene.hi.x : scene.lo.x,
+                                       k & 2 ? scene.hi.y : scene.lo.y,
+                                       k & 4 ? scene.hi.z : scene.lo.z);
+                const glm::vec4 clip = s.viewProj * glm::vec4(corner, 1.0f);
+                EXPECT_LE(std::abs(clip.x), 1.0f) << "corner " << k;
+                EXPECT_LE(std::abs(clip.y), 1.0f) << "corner " << k;
+                EXPECT_GE(clip.z, 0.0f) << "corner " << k;
+                EXPECT_LE(clip.z, 1.0f) << "corner " << k;
+            }
         }
     }
+    const OrthoLightFrame frame = frameFor(scene, {0.0f, -1.0f, 0.0f});
     settings.count = 0;
     EXPECT_TRUE(fitShadowCascades(cam, 1.0f, scene, frame, settings).empty());
 }

@@ -404,6 +404,113 @@ TEST_F(GpuSsvp, WarmUpRunsUntilKmeansConvergesThenTheImageIsFixed) {
     h.setup();
     cold = h.warmUp(0);
     EXPECT_EQ(cold.run, 0);
+
+    // A slow start (issue 43: the test above never showed the extension): two K-means passes per
+    // frame over 32 clusters do not converge in the one requested frame (measured: 7 frames), so
+    // the harness renders more, and stops once it has. (One pass per frame never settles on this
+    // box within the 64-frame cap; the run then records warmup_settled = false.)
+    FrameHarness slow(*m_ctx, scene, "ssvp",
+                      ssvpParams({{"clusters", "32"}, {"kmeans_iterations", "2"}}),
+                      defaultSharedParams());
+    slow.setup();
+    const WarmupResult w = slow.warmUp(1);
+    std::printf("slow start: %d warm-up frames for 1 requested, settled %d\n", w.run,
+                int(w.settled));
+    EXPECT_GT(w.run, 1);
+    EXPECT_TRUE(w.settled);
+    EXPECT_LT(w.run, FrameHarness::kMaxWarmupFrames);
+    slow.renderFrame();
+    EXPECT_EQ(stat(slow, "kmeans_converged"), 1.0);
+}
+
+// Interleaved sub-images, bounce by bounce (issue 43): the second-bounce disk sets hold
+// N2 / C = 32 VPLs, too few for `blocks` at I = 4, which then split them like `modulo` (one strip
+// of each disk per sub-image). Small sets are now split by fold (power-of-two strides). At I = 2
+// and 4, for the first and the second bounce apart (bounces = 2 minus bounces = 1; no blur, so
+// the pattern itself is scored), the mean equals I = 1's within `meanTolerance` and the default
+// split's relMSE against I = 1 is no worse than fold's (10 % margin).
+void checkInterleavedBounces(vk::Context& ctx, const Scene& scene, double meanTolerance) {
+    auto indirect = [&](const std::string& interleave, const std::string& subsets,
+                        const std::string& bounces) {
+        FrameHarness h(ctx, scene, "ssvp",
+                       ssvpParams({{"interleave", interleave},
+                                   {"interleave_subsets", subsets},
+                                   {"bounces", bounces},
+                                   {"blur_radius", "0"}}),
+                       defaultSharedParams());
+        h.setup();
+        h.warmUp(1);
+        h.renderFrame();
+        for (const ImageLayer& l : h.readLayers())
+            if (l.name == "indirect") return l.image;
+        throw Error("no indirect layer");
+    };
+    auto bounce = [&](const std::string& i, const std::string& subsets, int b) {
+        Image one = indirect(i, subsets, "1");
+        if (b == 1) return one;
+        Image two = indirect(i, subsets, "2");
+        for (size_t k = 0; k < two.values().size(); ++k)
+            two.values()[k] -= one.values()[k];
+        return two;
+    };
+    auto mean = [](const Image& im) {
+        double s = 0.0;
+        for (float v : im.values())
+            s += v;
+        return s / double(im.values().size());
+    };
+    // relMSE per channel, its epsilon 1e-2 of the reference's squared mean (the images' own
+    // scale: the second bounce is about a tenth of the first).
+    auto relMse = [&](const Image& a, const Image& ref) {
+        const double eps = 1e-2 * mean(ref) * mean(ref);
+        double s = 0.0;
+        for (size_t k = 0; k < a.values().size(); ++k) {
+            const double d = double(a.values()[k]) - double(ref.values()[k]);
+            s += d * d / (double(ref.values()[k]) * double(ref.values()[k]) + eps);
+        }
+        return s / double(a.values().size());
+    };
+    for (int b : {1, 2}) {
+        const Image full = bounce("1", "blocks", b);
+        const double m1 = mean(full);
+        ASSERT_GT(m1, 0.0);
+        for (const char* i : {"2", "4"}) {
+            std::map<std::string, double> err;
+            for (const char* subsets : {"blocks", "fold", "modulo"}) {
+                const Image im = bounce(i, subsets, b);
+                err[subsets] = relMse(im, full);
+                std::printf("bounce %d, I = %s, %s: mean / I=1 %.4f, relMSE vs I=1 %.4f\n", b, i,
+                            subsets, mean(im) / m1, err[subsets]);
+                if (std::string(subsets) != "modulo")
+                    EXPECT_NEAR(mean(im) / m1, 1.0, meanTolerance)
+                        << b << " " << i << " " << subsets;
+            }
+            EXPECT_LE(err["blocks"], 1.1 * err["fold"]) << "bounce " << b << ", I = " << i;
+        }
+    }
+}
+
+// Measured (lavapipe, 64^2): means within 1.9 % of I = 1 for every split; relMSE blocks / fold /
+// modulo: bounce 1 at I = 4 0.96 / 1.01 / 2.41; bounce 2 at I = 4 0.88 / 0.88 / 0.77 (on this
+// box the second bounce's strips cost nothing; Sponza's below shows them).
+TEST_F(GpuSsvp, InterleavedSubImagesKeepEachBouncesMeanOnTheSpotBox) {
+    checkInterleavedBounces(*m_ctx, cornell("spot", 64), 0.05);
+}
+
+// Sponza's sun (96^2; needs ../shared): relMSE at I = 4, bounce 2: blocks (= fold now) 0.54,
+// modulo 0.68, which the old `blocks` was; bounce 1 blocks 1.30, fold 1.71, modulo 2.96. Means
+// within 7 % for blocks and fold (the sub-images of 96^2 pixels see different receivers).
+TEST_F(GpuSsvp, InterleavedSubImagesSpreadTheSecondBounceOnSponza) {
+    const std::string file = std::string(GILAB_SOURCE_DIR) + "/scenes/sponza.json";
+    Scene scene;
+    try {
+        scene = loadSceneFile(file, "");
+    } catch (const Error& e) {
+        GTEST_SKIP() << "shared scenes not found (" << e.what() << ")";
+    }
+    scene.settings.width = 96;
+    scene.settings.height = 96;
+    checkInterleavedBounces(*m_ctx, scene, 0.08);
 }
 
 // Does a cluster's map see its own members (issue 29)? On the spot-lit Cornell box at C = 8

@@ -313,3 +313,27 @@ TEST(CpuRender, ShadowMemoryLimitIsCheckedBeforeRendering) {
 }
 
 }  // namespace gilab
+
+namespace gilab {
+
+// Issue 43: a technique that claims bounces and returns a black indirect layer under a lit direct
+// layer says so in its notes (cvgi once lit no voxel of a thin wall, with status ok and no note).
+TEST_F(GpuHarness, ATechniqueThatLightsNothingSaysSo) {
+    const Scene scene = smallBox();
+    auto notesFor = [&](const char* value) {
+        ParamSet p = TechniqueRegistry::instance().defaultParams("dummy_constant");
+        p.set("value", value);
+        FrameHarness h(*m_ctx, scene, "dummy_constant", p, defaultSharedParams());
+        h.setup();
+        h.renderFrame();
+        h.readLayers();
+        int said = 0;
+        for (const std::string& n : h.notes())
+            said += n.find("dummy_constant lights nothing") != std::string::npos;
+        return said;
+    };
+    EXPECT_EQ(notesFor("0"), 1);
+    EXPECT_EQ(notesFor("0.25"), 0);
+}
+
+}  // namespace gilab

@@ -268,18 +268,17 @@ const glm::vec3 kAlbedo(0.5f, 0.25f, 1.0f);
 // differ in the filtered levels (3^3 Gaussian vs cell pyramid) and sample positions. Before the
 // octree got the irradiance injection and facing: relMSE 0.121, mean abs 0.245, ratio 1.006
 // (isotropic) and 0.177, 0.350, 0.940 (anisotropic).
-constexpr double kAgreementRelMse = 0.2;     // measured 0.046
-constexpr double kAgreementMeanAbs = 0.4;    // measured 0.232
-constexpr double kAgreementMeanRatio = 0.2;  // measured 1.066
-// Both anisotropic. Issue 9 asks for the mean within 15 %; measured 0.725: facing removed the
-// octree's excess on the floor (1.51x -> 0.76x the reference; dense 0.91x), the octree's ceiling
-// stays at 0.61x (dense 1.02x), see docs/techniques/vct_svo.md.
-// Default octree_filter = slab (walls on odd samples stay opaque; the dense pyramid has no parity
-// problem but is dimmer than the reference at 64^3-128^3): measured relMSE 0.108, mean |diff|
-// 0.318, octree / dense 1.235 (pairs: 0.171, 0.324, 0.725).
-constexpr double kAnisoAgreementRelMse = 0.25;
-constexpr double kAnisoAgreementMeanAbs = 0.6;
-constexpr double kAnisoAgreementMeanRatio = 0.3;
+// Issue 43: the bounds were 4x the measured agreement, so they could not catch a change of it.
+// Measured again on lavapipe (the image is deterministic): isotropic relMSE 0.0342, mean abs
+// 0.203, ratio 0.850 (1.066 at 8e5c056); anisotropic (octree_filter = slab) 0.0309, 0.168,
+// 1.026. Bounds: 1.5x the measured errors, the ratio within 0.06 of the measured one.
+constexpr double kAgreementRelMse = 0.05;
+constexpr double kAgreementMeanAbs = 0.30;
+constexpr double kAgreementMeanRatio = 0.85;
+constexpr double kAnisoAgreementRelMse = 0.047;
+constexpr double kAnisoAgreementMeanAbs = 0.25;
+constexpr double kAnisoAgreementMeanRatio = 1.026;
+constexpr double kAgreementRatioTolerance = 0.06;
 
 TEST_F(GpuVctSvoTest, LeafNodesAreTheOccupiedLeafCells) {
     build(boxScene(kAlbedo, kLo, kHi));
@@ -506,7 +505,7 @@ TEST_F(GpuVctSvoTest, OctreeAndDenseGiveTheSameIndirectLight) {
     const Agreement a = octreeVsDense(*m_ctx, false);
     EXPECT_LT(a.relMse, kAgreementRelMse);
     EXPECT_LT(a.relMeanAbs, kAgreementMeanAbs);
-    EXPECT_NEAR(a.meanRatio, 1.0, kAgreementMeanRatio);
+    EXPECT_NEAR(a.meanRatio, kAgreementMeanRatio, kAgreementRatioTolerance);
 }
 
 // Both anisotropic (vct's default): the octree's directional bricks vs the dense directional
@@ -515,7 +514,7 @@ TEST_F(GpuVctSvoTest, AnisotropicOctreeAndDenseGiveTheSameIndirectLight) {
     const Agreement a = octreeVsDense(*m_ctx, true);
     EXPECT_LT(a.relMse, kAnisoAgreementRelMse);
     EXPECT_LT(a.relMeanAbs, kAnisoAgreementMeanAbs);
-    EXPECT_NEAR(a.meanRatio, 1.0, kAnisoAgreementMeanRatio);
+    EXPECT_NEAR(a.meanRatio, kAnisoAgreementMeanRatio, kAgreementRatioTolerance);
 }
 
 /** A one-voxel wall: the plane x = layer + 0.5 (voxel layer 16) across the whole 32^3 grid,

@@ -10,6 +10,7 @@
 
 #include <gtest/gtest.h>
 #include <map>
+#include <set>
 
 #include <glm/glm.hpp>
 #include "tests/gpu_test_fixture.h"
@@ -190,6 +191,47 @@ TEST(CpuVplMath, InterleaveSubsetsPartitionTheSetAndSpreadOverTheRsm) {
     for (uint32_t c : nine) {
         EXPECT_GE(c, 24u);
         EXPECT_LE(c, 32u);
+    }
+}
+
+// Issue 43: every set is spread, whatever its size. ssvp's second-bounce disk sets hold N2 / C = 32
+// VPLs, too few for blocks at I = 4 (L = 1): `blocks` fell back to `modulo`'s strips there. Now,
+// for I = 2, 3, 4 and sets of 32 to 1024 VPLs, fold and blocks (and its shifted rows at L = 1)
+// give every subset of two or more points points in both halves of the set in x and in y, and
+// stay a partition into shares that differ by at most one block; modulo, at even strides, never
+// does.
+TEST(CpuVplMath, InterleaveSubsetsSpreadEverySetSize) {
+    for (uint32_t stride : {4u, 9u, 16u}) {
+        for (uint32_t n : {32u, 48u, 64u, 128u, 256u, 1024u}) {
+            for (uint32_t mode = 0; mode < 3; ++mode) {
+                for (uint32_t rotation : {0u, 1u, 5u}) {
+                    std::vector<std::vector<uint32_t>> members(stride);
+                    for (uint32_t k = 0; k < n; ++k)
+                        members[vpl::interleaveSubset(k, n, stride, rotation, mode)].push_back(k);
+                    uint32_t narrow = 0;
+                    size_t fewest = n, most = 0;
+                    for (const std::vector<uint32_t>& m : members) {
+                        fewest = std::min(fewest, m.size());
+                        most = std::max(most, m.size());
+                        std::set<int> xHalf, yHalf;
+                        for (uint32_t k : m) {
+                            const glm::vec2 u = vpl::hammersley(k, n);
+                            xHalf.insert(int(u.x * 2.0f));
+                            yHalf.insert(int(u.y * 2.0f));
+                        }
+                        if (m.size() >= 2 && (xHalf.size() < 2 || yHalf.size() < 2)) ++narrow;
+                    }
+                    // Equal shares up to one block (one point when L = 1).
+                    EXPECT_LE(most - fewest, vpl::interleaveBlock(n, stride))
+                        << stride << " " << n << " " << mode;
+                    if (mode == 2 && stride % 2 == 0)  // strips of y (k, k + stride: same low bits)
+                        EXPECT_GT(narrow, 0u) << "modulo, stride " << stride << " n " << n;
+                    else if (mode != 2)
+                        EXPECT_EQ(narrow, 0u) << "mode " << mode << " stride " << stride << " n "
+                                              << n << " rotation " << rotation;
+                }
+            }
+        }
     }
 }
 

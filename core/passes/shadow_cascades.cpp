@@ -115,8 +115,22 @@ std::vector<ShadowCascade> fitShadowCascades(const Camera& camera, float aspect,
         }
         // Widen by the margin: texel = extent / (resolution - 2 margin)
         const glm::vec2 extent = glm::max(r.hi - r.lo, glm::vec2(1e-6f * frame.radius));
-        const glm::vec2 half = 0.5f * extent + float(settings.marginTexels) * extent / usable;
-        const glm::vec2 center = 0.5f * (r.lo + r.hi);
+        glm::vec2 half = 0.5f * extent + float(settings.marginTexels) * extent / usable;
+        glm::vec2 center = 0.5f * (r.lo + r.hi);
+        if (settings.snap) {
+            // Stable texels (issue 43): each half-extent rounded up to a quarter-octave step of
+            // the light's radius, r 2^(-k/4), so a small camera move keeps the size, and the
+            // centre moved to a whole texel, so the texel grid stays fixed in the light's space
+            // and a fixed world point keeps its texel (shadow edges do not crawl). At most 19 %
+            // coarser texels; the margin absorbs the half-texel shift.
+            for (int a = 0; a < 2; ++a) {
+                const float ratio = std::max(half[a], 1e-30f) / frame.radius;
+                const float steps = std::floor(-4.0f * std::log2(ratio));
+                half[a] = frame.radius * std::exp2(-steps / 4.0f);
+                const float texel = 2.0f * half[a] / float(settings.resolution);
+                center[a] = std::round(center[a] / texel) * texel;
+            }
+        }
         c.viewProj = orthoRect(frame, center.x, center.y, half.x, half.y);
         c.texel = 2.0f * std::max(half.x, half.y) / float(settings.resolution);
         out.push_back(c);

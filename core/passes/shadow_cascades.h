@@ -8,9 +8,11 @@
  *   z_i = lambda * n * (f / n)^(i / count) + (1 - lambda) * (n + (f - n) * i / count).
  * Each cascade is an orthographic map over the light-space rectangle of its slice's frustum,
  * clipped to the light-space rectangle of the scene box and widened by a margin of texels (for
- * PCF taps). Every cascade keeps the light's whole-scene depth range: distances are measured from
- * the entry plane of the scene's bounding sphere, as in the light's own map, so occluders outside
- * the camera's view still cast. docs/shared_passes.md has the measured defaults.
+ * PCF taps). With `snap` (default) each half-extent is rounded up to a quarter-octave step of the
+ * light's radius and the centre to a whole texel, so the texel grid does not move with the camera.
+ * Every cascade keeps the light's whole-scene depth range: distances are measured from the entry
+ * plane of the scene's bounding sphere, as in the light's own map, so occluders outside the
+ * camera's view still cast. docs/shared_passes.md has the measured defaults.
  */
 #include <cstdint>
 #include <vector>
@@ -42,6 +44,7 @@ struct CascadeSettings {
     float split = 0.5f;  // lambda: 0 uniform, 1 logarithmic
     uint32_t resolution = 1024;
     uint32_t marginTexels = 2;  // border kept free for PCF taps
+    bool snap = true;  // quarter-octave sizes and whole-texel centres (stable under camera motion)
 };
 
 /** The whole-scene orthographic view-projection (the light's own map), y down. */

@@ -164,6 +164,7 @@ void ShadowMaps::fitCascades(const PassLight& light, uint32_t index, uint32_t fi
     cs.count = m_settings.cascades;
     cs.split = m_settings.cascadeSplit;
     cs.resolution = m_settings.resolution;
+    cs.snap = m_settings.cascadeSnap;
     cs.marginTexels = uint32_t(m_settings.pcfRadius) + 2;
     const std::vector<ShadowCascade> fitted =
         fitShadowCascades(scene.camera, m_aspect, scene.caps.bounds, of, cs);

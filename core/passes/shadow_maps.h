@@ -60,6 +60,7 @@ struct ShadowSettings {
     bool receiverPlane = true;      // compare each texel with the receiver's plane along its ray
     uint32_t cascades = 4;          // view-fitted maps per directional light (0 = none)
     float cascadeSplit = 0.5f;      // split scheme: 0 uniform, 1 logarithmic
+    bool cascadeSnap = true;        // stable cascade texels (shadow_cascades.h CascadeSettings)
     bool enabled = true;            // false: no maps at all, visibility = 1
 };
 

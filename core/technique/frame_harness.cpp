@@ -236,6 +236,8 @@ std::vector<ImageLayer> FrameHarness::readLayers() {
     Image normal = readImage(m_ctx, gb.normal, 3);
     Image position = readImage(m_ctx, gb.position, 4);
 
+    noteIfLightsNothing(indirect, direct);
+
     // Compose final = emission + direct + indirect, the same way for every technique.
     Image final(indirect.width(), indirect.height(), 3);
     for (size_t i = 0; i < final.values().size(); ++i)
@@ -256,6 +258,22 @@ std::vector<ImageLayer> FrameHarness::readLayers() {
     for (const DebugView& view : m_technique->debugViews())
         if (view.image) layers.push_back({"debug_" + view.name, readImage(m_ctx, *view.image, 3)});
     return layers;
+}
+
+void FrameHarness::noteIfLightsNothing(const Image& indirect, const Image& direct) {
+    if (claimedBounces(m_technique->info(), m_params) == 0) return;
+    const auto lit = [](const Image& im) {
+        for (float v : im.values())
+            if (v > 0.0f) return true;
+        return false;
+    };
+    if (lit(indirect) || !lit(direct)) return;
+    const std::string note = m_technique->info().id +
+                             " lights nothing: its indirect layer is black on every pixel while "
+                             "the direct light is not (see its stats for what it found lit)";
+    for (const std::string& n : m_notes)
+        if (n == note) return;
+    m_notes.push_back(note);
 }
 
 bool FrameHarness::readVplFrame(VplSet& vpls, Image& position, Image& normal, Image& albedo) {

@@ -125,6 +125,10 @@ private:
     TechniqueContext makeContext();
 
     vk::Context& m_ctx;
+    /** Adds a note when a technique that claims indirect bounces returns a black indirect layer
+     *  on a frame whose direct light is not black (it lit nothing: a silent failure otherwise). */
+    void noteIfLightsNothing(const Image& indirect, const Image& direct);
+
     glm::dvec3 m_renderOrigin{0.0};
     Scene m_scene;  // own copy, moved by -m_renderOrigin: setFrameState moves its lights, camera
     SceneChanges m_pending;

@@ -36,6 +36,10 @@ std::vector<ParamSpec> sharedPassParamSpecs() {
                  ParamStage::Rebuild),
         floatParam("shadow_cascade_split", d.cascadeSplit, 0.0, 1.0, "",
                    "Cascade split scheme: 0 uniform in depth, 1 logarithmic", ParamStage::Rebuild),
+        boolParam("shadow_cascade_snap", d.cascadeSnap,
+                  "Cascade sizes in quarter-octave steps and centres on whole texels, so the "
+                  "texel grid stays put when the camera moves (off: refit exactly, edges crawl)",
+                  ParamStage::Rebuild),
         intParam("area_light_samples", int(s.areaLightSamples), 0, 4096, "",
                  "Virtual point lights standing in for emissive surfaces in the direct pass "
                  "(0 = emitters light nothing directly)",
@@ -69,6 +73,7 @@ SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
     s.shadow.receiverPlane = p.getBool("shadow_receiver_plane");
     s.shadow.cascades = uint32_t(p.getInt("shadow_cascades"));
     s.shadow.cascadeSplit = p.getFloat("shadow_cascade_split");
+    s.shadow.cascadeSnap = p.getBool("shadow_cascade_snap");
     s.areaLightSamples = uint32_t(p.getInt("area_light_samples"));
     s.areaLightAnalytic = p.getBool("area_light_analytic");
     const double res = double(s.shadow.areaResolution);

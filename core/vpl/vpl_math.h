@@ -30,12 +30,23 @@ inline uint32_t interleaveFold(uint32_t k, uint32_t stride) {
         s ^= k & (stride - 1);
     return s;
 }
-/** mode: 0 fold (power-of-two strides, else blocks), 1 blocks, 2 modulo. */
+/** Blocks of fewer than 4 points per run (vpl.glsl vplSmallSet): fold or shifted rows. */
+inline bool interleaveSmallSet(uint32_t n, uint32_t stride) {
+    return interleaveBlock(n, stride) < 4;
+}
+/** mode: 0 fold (power-of-two strides, else blocks), 1 blocks (small sets: fold for power-of-two
+ *  strides, else rows shifted by c), 2 modulo. */
 inline uint32_t interleaveSubset(uint32_t k, uint32_t n, uint32_t stride, uint32_t rotation,
                                  uint32_t mode = 0) {
-    if (mode == 0 && stride > 0 && (stride & (stride - 1)) == 0)
-        return interleaveFold(k, stride) ^ (rotation & (stride - 1));
     if (mode == 2) return (k + rotation) % stride;
+    const bool small = interleaveSmallSet(n, stride);
+    const bool powerOfTwo = stride > 0 && (stride & (stride - 1)) == 0;
+    if ((mode == 0 || small) && powerOfTwo)
+        return interleaveFold(k, stride) ^ (rotation & (stride - 1));
+    if (small) {
+        const uint32_t c = stride % 2 == 0 ? 1 : 2;
+        return (k % stride + (c * (k / stride)) % stride + rotation) % stride;
+    }
     return (k / interleaveBlock(n, stride) + rotation) % stride;
 }
 

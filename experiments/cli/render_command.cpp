@@ -184,6 +184,11 @@ int runRender(const RenderOptions& options) {
         gpu["median"].is_number() ? gpu["median"].get<double>() : -1.0, options.frames);
     for (const auto& skipped : meta["skipped_passes"])
         std::printf("  skipped %s\n", skipped.get<std::string>().c_str());
+    for (const auto& note : meta["notes"]) {
+        const std::string n = note.get<std::string>();
+        if (n.find(" lights nothing: ") != std::string::npos)
+            std::fprintf(stderr, "gilab: warning: %s\n", n.c_str());
+    }
     std::printf("  wrote %s/{output.exr,final.png,indirect.png,result.json}\n",
                 outDir.string().c_str());
     if (nonFinite)

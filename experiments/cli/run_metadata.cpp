@@ -257,18 +257,24 @@ nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<Fr
 }
 
 nlohmann::ordered_json dynamicTimingJson(const std::vector<FrameTiming>& frames) {
-    std::vector<double> cpu, gpu, update;
+    std::vector<double> cpu, gpu, update, shared, own;
     std::vector<std::string> order;
     std::map<std::string, std::vector<double>> passes;
     for (const FrameTiming& f : frames) {
         if (!f.dynamic) continue;
         cpu.push_back(f.cpuMs);
         update.push_back(f.updateCpuMs);
-        std::vector<const vk::PassTime*> all;
+        // Shared passes (G-buffer, shadow maps and cascades, direct light: names without a
+        // technique prefix) apart from the technique's own "<id>/..." passes (issue 43).
+        std::vector<const vk::PassTime*> all, sharedPasses, ownPasses;
         for (const std::vector<vk::PassTime>* list : {&f.passes, &f.updatePasses})
-            for (const vk::PassTime& p : *list)
+            for (const vk::PassTime& p : *list) {
                 all.push_back(&p);
+                (p.name.find('/') == std::string::npos ? sharedPasses : ownPasses).push_back(&p);
+            }
         gpu.push_back(topLevelGpuMs(all));
+        shared.push_back(topLevelGpuMs(sharedPasses));
+        own.push_back(topLevelGpuMs(ownPasses));
         // Update passes may repeat a name (one submission per light): summed per frame.
         std::map<std::string, double> perFrame;
         for (const vk::PassTime& p : f.updatePasses) {
@@ -284,6 +290,8 @@ nlohmann::ordered_json dynamicTimingJson(const std::vector<FrameTiming>& frames)
     return {{"dynamic_frames", cpu.size()},
             {"dynamic_frame_cpu_ms", summaryJson(cpu)},
             {"dynamic_frame_gpu_ms", summaryJson(gpu)},
+            {"dynamic_frame_shared_gpu_ms", summaryJson(shared)},
+            {"dynamic_frame_technique_gpu_ms", summaryJson(own)},
             {"update_cpu_ms", summaryJson(update)},
             {"update_passes", list}};
 }

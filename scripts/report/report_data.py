@@ -207,6 +207,10 @@ class Animation:
     temporal: Temporal = field(default_factory=Temporal)
     temporal_matched: Temporal = field(default_factory=Temporal)
     dynamic: TimeSummary = field(default_factory=TimeSummary)  # dynamic_frame_{gpu,cpu}_ms
+    # The dynamic frame's shared passes (G-buffer, shadow maps and cascades, direct light) and
+    # the technique's own passes, GPU clock (timing.dynamic_frame_{shared,technique}_gpu_ms)
+    dynamic_shared: TimeSummary = field(default_factory=TimeSummary)
+    dynamic_technique: TimeSummary = field(default_factory=TimeSummary)
     update_cpu: TimeSummary = field(default_factory=TimeSummary)  # update_cpu_ms
     update_passes: list[tuple[str, Optional[float]]] = field(default_factory=list)
     update_pass_times: dict[str, TimeSummary] = field(default_factory=dict)  # name -> summary
@@ -285,6 +289,9 @@ def parse_animation(data: dict) -> Optional["Animation"]:
         temporal=Temporal.parse(sequence.get("temporal")),
         temporal_matched=Temporal.parse(sequence.get("temporal_matched")),
         dynamic=dynamic,
+        dynamic_shared=TimeSummary.parse(dig(data, "timing", "dynamic_frame_shared_gpu_ms"), "gpu"),
+        dynamic_technique=TimeSummary.parse(dig(data, "timing", "dynamic_frame_technique_gpu_ms"),
+                                            "gpu"),
         update_cpu=TimeSummary.parse(dig(data, "timing", "update_cpu_ms"), "cpu"),
         update_passes=update_passes,
         update_pass_times=update_pass_times)

@@ -219,6 +219,10 @@ def _frame_cell(run: Run) -> tuple[str, object]:
     shown = time_with_bar(frame.median, frame.iqr)
     if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
+    shared, own = run.anim.dynamic_shared.median, run.anim.dynamic_technique.median
+    if shared is not None and own is not None:
+        shown += (f' <span class="pm">(shared passes {shared:.3g} ms, technique {own:.3g} ms)'
+                  '</span>')
     return shown, frame.median
 
 
@@ -229,6 +233,10 @@ def _dynamic_cell(run: Run) -> tuple[str, object]:
     shown = time_with_bar(frame.median, frame.iqr)
     if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
+    shared, own = run.anim.dynamic_shared.median, run.anim.dynamic_technique.median
+    if shared is not None and own is not None:
+        shown += (f' <span class="pm">(shared passes {shared:.3g} ms, technique {own:.3g} ms)'
+                  '</span>')
     return shown, frame.median
 
 
@@ -354,7 +362,10 @@ def run_columns(page: Page) -> list[Column]:
         Column("dynamic_frame", f"{time_label(animated, 'frame time', dynamic=True)} ± IQR",
                "animated scenes: median time of a frame in which the light or camera moved, the "
                "technique's update included (timing.dynamic_frame_gpu_ms, else _cpu_ms); the "
-               "time the scene's rankings use", _dynamic_cell),
+               "time the scene's rankings use. In brackets its GPU time split: the shared "
+               "passes every technique pays (G-buffer, shadow maps and cascades re-rendered "
+               "after a camera move, direct light) and the technique's own passes",
+               _dynamic_cell),
         Column("update", "update kind", "animated scenes: how the technique follows the motion "
                "(incremental / full rebuild: no real update path / none)", _update_cell, False,
                ""),

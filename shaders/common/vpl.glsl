@@ -83,11 +83,19 @@ float vplDiskSampleWeight(vec2 p) {
 // the set holding stride points, of any aspect ratio, has one point of each subset. Other
 // strides: blocks of L consecutive points go round-robin, subset (k / L + rotation) mod stride,
 // L the largest power of two with L^2 stride <= n (L strata of y, n / (L stride) of x).
+// A set too small for blocks of 4 or more (L < 4: fewer than 16 stride points; ssvp's
+// second-bounce disk sets of N2 / C = 32 at I = 4 gave L = 1, i.e. `modulo`'s strips) is split by
+// fold when the stride is a power of two (measured better than blocks there, issue 43), else row
+// by row: point k = h stride + j of row h joins subset (j + c h + rotation) mod stride, c = 1 for
+// an even stride and 2 for an odd one, so that a subset's points in successive rows are
+// stride - c apart, an odd step: their low bits, y's high bits, differ, and each row is one x
+// stratum.
 uint vplInterleaveBlock(uint n, uint stride) {
     uint block = 1u;
     while (4u * block * block * stride <= n) block *= 2u;
     return block;
 }
+uint vplRowShift(uint stride) { return (stride & 1u) == 0u ? 1u : 2u; }
 bool vplPowerOfTwo(uint v) { return v > 0u && (v & (v - 1u)) == 0u; }
 uint vplFold(uint k, uint stride) {
     if (stride <= 1u) return 0u;
@@ -96,10 +104,15 @@ uint vplFold(uint k, uint stride) {
     return s;
 }
 // mode (core/vpl/vpl_shading.h InterleaveSubsets): 0 fold (power-of-two strides, else blocks),
-// 1 blocks, 2 modulo (k + rotation) mod stride.
+// 1 blocks (small sets: fold or shifted rows), 2 modulo (k + rotation) mod stride.
+// Blocks of fewer than 4 points per run: the small-set rule above.
+bool vplSmallSet(uint n, uint stride) { return vplInterleaveBlock(n, stride) < 4u; }
 uint vplInterleaveSubset(uint k, uint n, uint stride, uint rotation, uint mode) {
-    if (mode == 0u && vplPowerOfTwo(stride)) return vplFold(k, stride) ^ (rotation & (stride - 1u));
     if (mode == 2u) return (k + rotation) % stride;
+    bool small = vplSmallSet(n, stride);
+    if ((mode == 0u || small) && vplPowerOfTwo(stride))
+        return vplFold(k, stride) ^ (rotation & (stride - 1u));
+    if (small) return (k % stride + (vplRowShift(stride) * (k / stride)) % stride + rotation) % stride;
     return (k / vplInterleaveBlock(n, stride) + rotation) % stride;
 }
 

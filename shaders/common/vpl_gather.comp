@@ -64,7 +64,8 @@ void shade(uint i, vec3 p, vec3 n, float minD2, inout vec3 e, inout vec3 removed
 // Subset s of the set vpls[base, base + n) whose subsets are rotated by `rotation`.
 void shadeSubset(uint base, uint n, uint rotation, uint s, uint stride, vec3 p, vec3 nrm,
                  float minD2, inout vec3 e, inout vec3 removed) {
-    if (pc.subsets == 0u && vplPowerOfTwo(stride)) {
+    bool small = vplSmallSet(n, stride);
+    if ((pc.subsets == 0u || small) && pc.subsets != 2u && vplPowerOfTwo(stride)) {
         // fold(k) = (k mod stride) xor fold(k / stride): one k per high part h.
         uint bits = uint(findLSB(stride));
         for (uint h = 0u; (h << bits) < n; ++h) {
@@ -79,6 +80,16 @@ void shadeSubset(uint base, uint n, uint rotation, uint s, uint stride, vec3 p, 
         return;
     }
     uint block = vplInterleaveBlock(n, stride);
+    if (small) {
+        // Row h holds subset s at j = (s - c h - rotation) mod stride (vplInterleaveSubset).
+        uint c = vplRowShift(stride), r = rotation % stride;
+        for (uint h = 0u; h * stride < n; ++h) {
+            uint j = (s + 2u * stride - r - (c * h) % stride) % stride;
+            uint k = h * stride + j;
+            if (k < n) shade(base + k, p, nrm, minD2, e, removed);
+        }
+        return;
+    }
     for (uint b = (s + stride - rotation % stride) % stride; b * block < n; b += stride)
         for (uint k = b * block; k < min(n, b * block + block); ++k)
             shade(base + k, p, nrm, minD2, e, removed);

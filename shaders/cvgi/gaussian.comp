@@ -5,8 +5,8 @@
 // emitter state and faces that gathered nothing ("non-lit") get weight 0, then the weights are
 // renormalised (no shadow leaks). Run twice: faceIrradiance -> faceTemp -> faceFiltered.
 // gaussian_visibility (ours, u.packing.w): a neighbour also gets weight 0 when the straight path
-// between the two faces' front cells crosses an occupied voxel, so a lit face does not spread
-// through a wall (docs/techniques/cvgi.md, "The Gaussian filter").
+// between the two faces' front cells crosses an occupied voxel, or either front cell is occupied
+// (a buried face), so a lit face does not spread through a wall (docs/techniques/cvgi.md, "The Gaussian filter").
 #include "cvgi/cvgi_common.glsl"
 
 layout(local_size_x = 64) in;
@@ -27,9 +27,12 @@ void store(uint face, vec4 e) {
     else faceFiltered[face] = e;
 }
 
-// True when no occupied voxel lies strictly between cells a and b (sampled at the cells the
-// segment passes through, one per step of its longest axis).
+// True when cells a and b are empty and no occupied voxel lies between them (sampled at the cells
+// the segment passes through, one per step of its longest axis). An occupied end is a buried face:
+// it cannot tell which side of a wall it serves (a ceiling voxel in a one-voxel wall's column
+// would take the lit room's ceiling through the wall), so it neither gives nor takes.
 bool pathOpen(ivec3 a, ivec3 b) {
+    if (cvgiIndexAt(a) != CVGI_EMPTY || cvgiIndexAt(b) != CVGI_EMPTY) return false;
     ivec3 d = b - a;
     int steps = max(abs(d.x), max(abs(d.y), abs(d.z)));
     for (int k = 1; k < steps; ++k) {
@@ -62,7 +65,8 @@ void main() {
                 if (j == CVGI_EMPTY || (voxelState[j] & CVGI_PROCESSED) == 0u) continue;
                 vec4 e = source(6u * j + f);
                 if (e.w <= 0.0 || max(e.r, max(e.g, e.b)) <= 0.0) continue;  // non-lit face
-                if (visibility && !pathOpen(front, front + ivec3(x, y, z))) continue;
+                bool self = x == 0 && y == 0 && z == 0;
+                if (visibility && !self && !pathOpen(front, front + ivec3(x, y, z))) continue;
                 float w = exp(-float(x * x + y * y + z * z) * inv2s2);
                 sum += w * e.rgb;
                 weight += w;

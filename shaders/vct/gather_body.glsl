@@ -61,7 +61,8 @@ void main() {
     float offset = gather.specular.z;
 
     // Diffuse cones (and AO with the same set)
-    uint count = min(uint(gather.coneInfo.x + 0.5), 16u);
+    bool level0Control = (flags & GATHER_FLAG_LEVEL0_RAYS) != 0u;
+    uint count = level0Control ? 0u : min(uint(gather.coneInfo.x + 0.5), 16u);
     float tanHalf = gather.coneInfo.y;
     vec3 diffuse = vec3(0.0);
     float visibility = 0.0;
@@ -73,6 +74,25 @@ void main() {
             visibility +=
                 w * traceSurfaceConeVisibility(surface, offset, dir, tanHalf, p.distances.x, p);
         }
+    }
+    if (level0Control) {
+        // The control (issue 43): M cosine-distributed rays (a Hammersley set, rotated per pixel)
+        // marched at aperture 0, i.e. through the finest voxels only with the same compositing,
+        // step, facing and lift; E = (pi / M) sum L. Not the method.
+        uint m = max(gather.sizeFlags.w, 1u);
+        uint h = uint(pixel.x) * 1973u + uint(pixel.y) * 9277u + 26699u;
+        h = (h ^ (h >> 16)) * 0x7feb352du;
+        h = (h ^ (h >> 15)) * 0x846ca68bu;
+        vec2 shift = vec2(float(h & 0xffffu), float(h >> 16)) / 65536.0;
+        diffuse = vec3(0.0);
+        for (uint i = 0u; i < m; ++i) {
+            vec2 u = fract(vec2((float(i) + 0.5) / float(m),
+                                float(bitfieldReverse(i)) * 2.3283064365386963e-10) + shift);
+            float r = sqrt(u.x), phi = 2.0 * BRDF_PI * u.y;
+            vec3 local = vec3(r * cos(phi), r * sin(phi), sqrt(max(1.0 - u.x, 0.0)));
+            diffuse += traceSurfaceCone(surface, offset, coneToWorld(local, n), 0.0, p).rgb;
+        }
+        diffuse *= BRDF_PI / float(m);
     }
     vec3 indirect = albedo * (1.0 - metalRough.x) * (1.0 / BRDF_PI) * diffuse;
 

@@ -14,6 +14,7 @@
 #define GATHER_FLAG_SPECULAR 1u
 #define GATHER_FLAG_AO 2u
 #define GATHER_FLAG_ANISOTROPIC 4u
+#define GATHER_FLAG_LEVEL0_RAYS 8u  // control: sizeFlags.w rays at level 0 instead of the cones
 
 layout(set = 0, binding = 0, rgba32f) uniform readonly image2D gPosition;
 layout(set = 0, binding = 1, rgba32f) uniform readonly image2D gNormal;
@@ -32,7 +33,7 @@ layout(set = 0, binding = 6, std140) uniform GatherParams {
     vec4 cones[16];  // xyz tangent-space direction, w weight (sum = pi)
     vec4 coneInfo;   // x count, y tan(aperture / 2)
     vec4 cameraPosition;  // xyz world
-    uvec4 sizeFlags;      // x width, y height, z GATHER_FLAG_* bits
+    uvec4 sizeFlags;      // x width, y height, z GATHER_FLAG_* bits, w level-0 control rays
     vec4 specular;        // x min aperture (rad), y max aperture (rad), z origin offset (world)
     VoxelGridInfo grid;   // the voxel grid (origin, v0, N)
 } gather;

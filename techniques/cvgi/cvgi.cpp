@@ -179,6 +179,12 @@ void CvgiTechnique::emitterUpdate(TechniqueContext& ctx) {
     const float aspect = float(ctx.width) / float(std::max(ctx.height, 1u));
     m_gpu->setCamera(ctx.scene.camera, aspect);
     ctx.submitTimed([&](VkCommandBuffer cmd) { m_gpu->recordEmitterUpdate(ctx, cmd); });
+    m_statsDue = true;  // read back in frameFinished(), outside the timed update
+}
+
+void CvgiTechnique::frameFinished(TechniqueContext& ctx) {
+    if (!m_statsDue || !m_gpu) return;
+    m_statsDue = false;
     recordUpdateStats(ctx);
 }
 
@@ -228,7 +234,7 @@ UpdateKind CvgiTechnique::update(TechniqueContext& ctx, const SceneChanges& chan
     const float aspect = float(ctx.width) / float(std::max(ctx.height, 1u));
     m_gpu->setCamera(ctx.scene.camera, aspect);
     ctx.submitTimed([&](VkCommandBuffer cmd) { m_gpu->recordCameraUpdate(ctx, cmd); });
-    recordUpdateStats(ctx);
+    m_statsDue = true;
     return UpdateKind::Incremental;
 }
 

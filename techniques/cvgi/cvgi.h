@@ -39,12 +39,15 @@ public:
     void onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys) override;
     UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes) override;
     void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) override;
+    /** Reads the update's counters back (stats), after the frame: not part of the timed update. */
+    void frameFinished(TechniqueContext& ctx) override;
 
 private:
     void emitterUpdate(TechniqueContext& ctx);
     void recordUpdateStats(TechniqueContext& ctx);
 
     std::unique_ptr<CvgiGpu> m_gpu;
+    bool m_statsDue = false;             // an update ran whose counters are not read yet
     cvgi::ClusterSightings m_sightings;  // what the faces' rays see, for the update stats
 };
 

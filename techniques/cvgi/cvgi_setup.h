@@ -102,8 +102,9 @@ struct ClusterSightings {
 ClusterSightings clusterSightings(const FaceVisibility& visibility, uint32_t clusterIds);
 
 /**
- * `rays` unit directions about +z, uniform in solid angle (Hammersley: cos theta = 1 - i/rays,
- * phi = 2 pi radicalInverse2(i)); ray 0 is +z itself. Deterministic.
+ * `rays` unit directions about +z, uniform in solid angle (Hammersley at stratum centres:
+ * cos theta = 1 - (i + 1/2)/rays, phi = 2 pi radicalInverse2(i)); the cosines sum to exactly
+ * rays / 2. Deterministic.
  */
 std::vector<glm::vec3> hemisphereDirections(uint32_t rays);
 

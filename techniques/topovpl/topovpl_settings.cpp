@@ -79,9 +79,10 @@ std::vector<ParamSpec> topovplParamSpecs() {
                   "(paper: min)"),
         floatParam("gate_radius_scale", 1.0, 0.0, 100.0, "",
                    "multiplies the gate radius (> 1: oversized disks, §VI-B)"),
-        enumParam("same_cluster_stat", "on", {"on", "off"},
-                  "diagnostic pass diag.same_cluster_share (not in the frame time): the share of "
-                  "the unshadowed VPL light that same-cluster pairs carry"),
+        enumParam("same_cluster_stat", "off", {"on", "off"},
+                  "diagnostic pass diag.same_cluster_share: the share of the unshadowed VPL light "
+                  "that same-cluster pairs carry (off by default: it runs in the frame's "
+                  "submission, so the frame's wall time would hold it)"),
     };
 }
 

@@ -25,7 +25,7 @@
 namespace gilab {
 namespace {
 
-constexpr uint32_t kFlagSpecular = 1u, kFlagAo = 2u, kFlagAnisotropic = 4u;
+constexpr uint32_t kFlagSpecular = 1u, kFlagAo = 2u, kFlagAnisotropic = 4u, kFlagLevel0Rays = 8u;
 constexpr uint32_t kParamsBinding = 6;
 
 /** Mirrors GatherParams in shaders/vct/gather_inputs.glsl (std140, all vec4). */
@@ -150,6 +150,11 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("specular_min_aperture_deg", 10.0, 0.1, 60.0, "deg",
                    "narrowest specular cone (paper: 10 deg, Table 1; the roughness mapping is "
                    "clamped to [this, 60])"),
+        intParam("control_level0_rays", 0, 0, 4096, "rays",
+                 "a control, not the method (issue 43): > 0 replaces the diffuse cones by that "
+                 "many cosine-distributed rays per pixel marched through the finest voxels only "
+                 "(no mips: the cone march at aperture 0), so the injected volume's light is "
+                 "gathered without cone tracing's filtering; 0 = the cones"),
         boolParam("ao", false, "trace AO cones (debug view \"ao\"; not applied to the image)",
                   rebuild),
         floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
@@ -375,7 +380,9 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
                   p.getEnum("lift_rule") == "blend" ? 1.0f : 0.0f, 0.0f);
     g.coneSet = toGpu(cones);
     g.cameraPosition = glm::vec4(ctx.scene.camera.position, 1.0f);
-    g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, 0u);
+    const uint32_t level0Rays = uint32_t(p.getInt("control_level0_rays"));
+    if (level0Rays > 0) flags |= kFlagLevel0Rays;
+    g.sizeFlags = glm::uvec4(ctx.width, ctx.height, flags, level0Rays);
     g.specular = glm::vec4(glm::radians(p.getFloat("specular_min_aperture_deg")),
                            glm::radians(60.0f), p.getFloat("origin_offset") * v0, 0.0f);
     g.grid = m_grid.gpu();
