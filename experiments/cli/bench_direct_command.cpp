@@ -22,6 +22,7 @@
 #include "core/util/strings.h"
 #include "core/vk/context.h"
 #include "experiments/cli/cli.h"
+#include "experiments/cli/light_placements.h"
 #include "experiments/cli/run_metadata.h"
 #include "experiments/metrics/direct_accuracy.h"
 #include "experiments/metrics/metrics.h"
@@ -100,18 +101,28 @@ struct Row {
     double directMs = 0.0, directIqr = 0.0, shadowSetupMs = 0.0;
 };
 
+Row benchLoaded(vk::Context& ctx, const Scene& scene, const std::string& label,
+                const BenchDirectOptions& options, const ref::ReferenceCache* cache);
+
 Row benchScene(vk::Context& ctx, const std::string& spec, const BenchDirectOptions& options,
                const ref::ReferenceCache* cache) {
-    Row row;
-    row.scene = spec;
     Scene scene;
     try {
         scene = loadScene(spec);
     } catch (const Error& e) {
+        Row row;
+        row.scene = spec;
         row.status = std::string("skipped: ") + e.what();
         return row;
     }
     applyResolutionOverride(scene, options.resolution);
+    return benchLoaded(ctx, scene, spec, options, cache);
+}
+
+Row benchLoaded(vk::Context& ctx, const Scene& scene, const std::string& label,
+                const BenchDirectOptions& options, const ref::ReferenceCache* cache) {
+    Row row;
+    row.scene = label;
     ParamSet params = TechniqueRegistry::instance().defaultParams("direct");
     ParamSet shared = defaultSharedParams();
     applyAssignments(options.assignments, params, shared);
@@ -182,6 +193,102 @@ Json rowJson(const Row& r) {
 
 }  // namespace
 
+/** The shipped scene files (their base variants) for --placements. */
+std::vector<std::string> shippedSceneFiles() {
+    std::vector<std::string> out;
+    for (const fs::path& dir : {scenesDir(), scenesDir() / "stress"}) {
+        std::vector<fs::path> files;
+        for (const fs::directory_entry& e : fs::directory_iterator(dir))
+            if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path());
+        std::sort(files.begin(), files.end());
+        for (const fs::path& f : files)
+            out.push_back(f.string());
+    }
+    return out;
+}
+
+double percentile(std::vector<double> v, double q) {
+    if (v.empty()) return std::nan("");
+    std::sort(v.begin(), v.end());
+    const double x = q * double(v.size() - 1);
+    const size_t i = size_t(x);
+    const double f = x - double(i);
+    return i + 1 < v.size() ? v[i] * (1.0 - f) + v[i + 1] * f : v[i];
+}
+
+/** --placements N: N random point and spot lights per scene (light_placements.h), each scored
+ *  like a shipped scene; per scene the median and 95th percentile of the leak, the median
+ *  energy and the worst placement. */
+int runPlacements(vk::Context& ctx, const BenchDirectOptions& options,
+                  const ref::ReferenceCache* cache, Json& rows, Json& summaries) {
+    const std::vector<std::string> files =
+        options.scenes.empty() ? shippedSceneFiles() : options.scenes;
+    std::vector<double> allLeaks, allEnergies;
+    for (const std::string& spec : files) {
+        Scene scene;
+        try {
+            scene = loadScene(spec);
+        } catch (const Error& e) {
+            std::printf("%-48s skipped: %s\n", spec.c_str(), e.what());
+            continue;
+        }
+        applyResolutionOverride(scene, options.resolution);
+        const std::vector<LightPlacement> placements =
+            randomLightPlacements(scene, options.placementSeed, options.placements);
+        std::vector<double> leaks, energies;
+        double worstLeak = -1.0;
+        std::string worst;
+        for (size_t k = 0; k < placements.size(); ++k) {
+            const Scene lit = withOnlyLight(scene, placements[k].light);
+            const std::string label = spec + " [" + std::to_string(k) + "]";
+            const Row r = benchLoaded(ctx, lit, label, options, cache);
+            Json j = rowJson(r);
+            j["placement"] = placements[k].label;
+            rows.push_back(j);
+            if (r.status != "ok" || !std::isfinite(r.accuracy.energyRatio)) {
+                std::printf("%-48s %s: %s\n", label.c_str(), placements[k].label.c_str(),
+                            r.status == "ok" ? "black reference" : r.status.c_str());
+                continue;
+            }
+            leaks.push_back(100.0 * r.accuracy.shadowLeak);
+            energies.push_back(r.accuracy.energyRatio);
+            if (100.0 * r.accuracy.shadowLeak > worstLeak) {
+                worstLeak = 100.0 * r.accuracy.shadowLeak;
+                worst = placements[k].label;
+            }
+            if (!options.quiet)
+                std::printf("%-48s %-7.4f %7.3f %%  %s\n", label.c_str(), r.accuracy.energyRatio,
+                            100.0 * r.accuracy.shadowLeak, placements[k].label.c_str());
+        }
+        if (leaks.empty()) continue;
+        allLeaks.insert(allLeaks.end(), leaks.begin(), leaks.end());
+        allEnergies.insert(allEnergies.end(), energies.begin(), energies.end());
+        const double median = percentile(leaks, 0.5), p95 = percentile(leaks, 0.95),
+                     energy = percentile(energies, 0.5);
+        std::printf(
+            "%-48s %3zu placements: leak median %.3f %%, p95 %.3f %%; energy median %.4f "
+            "(%.4f-%.4f); worst %.3f %% at %s\n",
+            spec.c_str(), leaks.size(), median, p95, energy,
+            *std::min_element(energies.begin(), energies.end()),
+            *std::max_element(energies.begin(), energies.end()), worstLeak, worst.c_str());
+        std::fflush(stdout);
+        summaries.push_back({{"scene", spec},
+                             {"placements", leaks.size()},
+                             {"leak_median_percent", median},
+                             {"leak_p95_percent", p95},
+                             {"energy_median", energy},
+                             {"worst_leak_percent", worstLeak},
+                             {"worst_placement", worst}});
+    }
+    if (!allLeaks.empty())
+        std::printf(
+            "all scenes, %zu placements: leak median %.3f %%, p95 %.3f %%; energy median "
+            "%.4f (targets: <= 0.3 %%, <= 1 %%, 1 +- 0.02)\n",
+            allLeaks.size(), percentile(allLeaks, 0.5), percentile(allLeaks, 0.95),
+            percentile(allEnergies, 0.5));
+    return kExitOk;
+}
+
 int runBenchDirect(const BenchDirectOptions& options) {
     Progress::setQuiet(options.quiet);
     std::vector<std::string> scenes = options.scenes.empty() ? shippedScenes() : options.scenes;
@@ -206,6 +313,11 @@ int runBenchDirect(const BenchDirectOptions& options) {
     std::printf("%-48s %-8s %-14s %7s %8s %8s %8s %9s %10s\n", "scene", "size", "lights", "energy",
                 "leak %", "miss %", "HDR-FLIP", "direct ms", "shadows ms");
     Json rows = Json::array();
+    Json summaries = Json::array();
+    if (options.placements > 0) {
+        runPlacements(ctx, options, cache ? &*cache : nullptr, rows, summaries);
+        scenes.clear();
+    }
     for (const std::string& spec : scenes) {
         const Row r = benchScene(ctx, spec, options, cache ? &*cache : nullptr);
         rows.push_back(rowJson(r));
@@ -239,6 +351,11 @@ int runBenchDirect(const BenchDirectOptions& options) {
                  {"area_spp", options.areaSpp},
                  {"provenance", provenanceJson(options.commandLine)},
                  {"scenes", rows}};
+        if (options.placements > 0) {
+            out["placements"] = options.placements;
+            out["placement_seed"] = options.placementSeed;
+            out["placement_summaries"] = summaries;
+        }
         const fs::path path = fs::path(options.outDir) / "bench_direct.json";
         std::ofstream(path) << out.dump(2) << "\n";
         std::printf("wrote %s\n", path.string().c_str());

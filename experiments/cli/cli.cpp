@@ -344,6 +344,14 @@ int runMain(int argc, char** argv) {
                                             "Neither read nor write the cache"));
     benchDirectCmd->add_option("--device", benchDirect.device,
                                "Vulkan device name substring or index");
+    benchDirectCmd
+        ->add_option("--placements", benchDirect.placements,
+                     "Random point and spot light placements per scene file (base variant, its "
+                     "lights and emitters replaced; near walls and in corners included) instead "
+                     "of the shipped lights; prints leak median / p95 and energy per scene")
+        ->check(CLI::Range(0u, 10000u));
+    benchDirectCmd->add_option("--seed", benchDirect.placementSeed, "Seed of --placements")
+        ->capture_default_str();
     benchDirectCmd->add_option("--out,-o", benchDirect.outDir, "Also write bench_direct.json here");
     benchDirectCmd->add_flag("--quiet,-q", benchDirect.quiet, "No progress lines");
 

@@ -96,6 +96,8 @@ struct BenchDirectOptions {
     std::string outDir;  // "" = print only
     bool quiet = false;
     std::string commandLine;
+    uint32_t placements = 0;     // > 0: random point/spot placements per scene file instead
+    uint32_t placementSeed = 1;  // light_placements.h
 };
 int runBenchDirect(const BenchDirectOptions& options);
 

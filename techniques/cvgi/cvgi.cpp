@@ -1,6 +1,7 @@
 #include "techniques/cvgi/cvgi.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 
@@ -153,6 +154,16 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
                  ? 100.0 * entries / double(visibility.uncompactedEntries)
                  : 0.0);
     m_sightings = cvgi::clusterSightings(visibility, clusters.count());
+    // Mean plane area in each voxel (v0^2 / |n|_1 of its mean normal; v0^2 when the normals
+    // cancel): the lit voxels' power, Sum B A, for the stat lit_power_w (issue 43).
+    m_voxelArea.assign(v, 0.0f);
+    const float v0 = grid.voxelSize();
+    for (uint32_t i = 0; i < v; ++i) {
+        const glm::vec3 m = voxels.meanNormal[i];
+        const float len = glm::length(m);
+        const float l1 = len > 0.1f ? (std::abs(m.x) + std::abs(m.y) + std::abs(m.z)) / len : 1.0f;
+        m_voxelArea[i] = v0 * v0 / l1;
+    }
     ctx.stat("clusters_per_face", m_sightings.clustersPerFace());
     ctx.stat("memory_final_mib", double(m_gpu->finalBytes()) / (1024.0 * 1024.0));
     ctx.note("voxel grid " + std::to_string(n) + "^3: " + std::to_string(v) + " voxels, " +
@@ -213,6 +224,13 @@ void CvgiTechnique::recordUpdateStats(TechniqueContext& ctx) {
     ctx.stat("lit_clusters_per_face",
              m_sightings.openFaces ? double(litEntries) / double(m_sightings.openFaces) : 0.0);
     ctx.stat("rays_per_lit_entry", litEntries ? double(raysOnLit) / double(litEntries) : 0.0);
+    // The power the lit voxels hold, Sum B A (mean of rgb, W): against the path tracer's
+    // one-bounce emission (vct's power_photons_reflected_w on the same scene), per resolution.
+    const std::vector<glm::vec4> light = m_gpu->readVoxelLight();
+    double power = 0.0;
+    for (size_t i = 0; i < light.size() && i < m_voxelArea.size(); ++i)
+        power += double(light[i].r + light[i].g + light[i].b) / 3.0 * double(m_voxelArea[i]);
+    ctx.stat("lit_power_w", power);
 }
 
 void CvgiTechnique::onParamsChanged(TechniqueContext& ctx, const std::vector<std::string>& keys) {

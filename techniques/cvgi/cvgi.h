@@ -20,6 +20,7 @@
  * Per frame: final_frame (face choice, bilinear face interpolation, albedo / pi).
  */
 #include <memory>
+#include <vector>
 
 #include "core/technique/technique.h"
 #include "techniques/cvgi/cvgi_settings.h"
@@ -49,6 +50,7 @@ private:
     std::unique_ptr<CvgiGpu> m_gpu;
     bool m_statsDue = false;             // an update ran whose counters are not read yet
     cvgi::ClusterSightings m_sightings;  // what the faces' rays see, for the update stats
+    std::vector<float> m_voxelArea;      // per voxel, the mean plane area inside it (m^2)
 };
 
 }  // namespace gilab

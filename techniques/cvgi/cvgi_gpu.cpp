@@ -366,6 +366,12 @@ std::vector<uint32_t> CvgiGpu::readLitCounts() {
     return lit;
 }
 
+std::vector<glm::vec4> CvgiGpu::readVoxelLight() {
+    std::vector<glm::vec4> light(m_voxelCount);
+    if (!light.empty()) m_voxelLight.download(light.data(), light.size() * sizeof(glm::vec4));
+    return light;
+}
+
 CvgiCounters CvgiGpu::readCounters() {
     uint32_t words[kCounterWords] = {};
     m_counters.download(words, sizeof(words));

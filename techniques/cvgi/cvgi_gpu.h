@@ -71,6 +71,8 @@ public:
     CvgiCounters readCounters();
     /** Lit voxels per cluster after the last emitter update (0 = not lit). */
     std::vector<uint32_t> readLitCounts();
+    /** Per voxel: rgb its radiosity B after the last emitter update (W/m^2), a lit lights. */
+    std::vector<glm::vec4> readVoxelLight();
     /** The camera distance map's size, and whether the device's image limit clamped it. */
     uint32_t cameraMapWidth() const { return m_cameraMapWidth; }
     uint32_t cameraMapHeight() const { return m_cameraMapHeight; }

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <string>
 
 #include <glm/glm.hpp>
@@ -155,6 +156,11 @@ TechniqueInfo VctTechnique::describe() {
                  "many cosine-distributed rays per pixel marched through the finest voxels only "
                  "(no mips: the cone march at aperture 0), so the injected volume's light is "
                  "gathered without cone tracing's filtering; 0 = the cones"),
+        boolParam("power_stats", false,
+                  "a diagnostic (issue 43; dense storage): after set-up, read back the volumes "
+                  "and report the power the photons brought (sum of albedo x flux per voxel) and "
+                  "the power the base volume holds (sum of pi L x the mean plane area in a voxel "
+                  "of its normal, v0^2 / |n|_1); read outside the timed frame"),
         boolParam("ao", false, "trace AO cones (debug view \"ao\"; not applied to the image)",
                   rebuild),
         floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
@@ -171,6 +177,7 @@ void VctTechnique::setup(TechniqueContext& ctx) {
     int mapRes = p.getInt("light_map_resolution");
     m_octree = p.getEnum("storage") == "octree";
     m_ao = p.getBool("ao");
+    m_powerStatsDue = p.getBool("power_stats");
     if (!ctx.scene.caps.bounds.valid()) throw Error("vct: the scene has no geometry");
 
     // Release the previous set-up's resources first (rebuild)
@@ -340,6 +347,46 @@ void VctTechnique::createGather(TechniqueContext& ctx) {
     m_gather = vk::ComputePipeline(
         ctx.vk, m_octree ? vct::SparseVoxelOctree::gatherShaderName() : "vct/gather_dense.comp",
         m_gatherLayout);
+}
+
+void VctTechnique::frameFinished(TechniqueContext& ctx) {
+    if (!m_powerStatsDue) return;
+    m_powerStatsDue = false;
+    if (!m_radiance || !m_voxelizer || !m_injection) return;
+    // Issue 43's control: what the photons brought against what the level-0 volume holds.
+    const std::vector<glm::vec3> flux = m_injection->readVoxelFlux();
+    uint32_t albedoChannels = 0, baseChannels = 0, normalChannels = 0;
+    const std::vector<float> albedo =
+        m_voxelizer->volumes().albedoOpacity.readbackFloat(ctx.vk, 0, 0, &albedoChannels);
+    const std::vector<float> base = m_radiance->base().readbackFloat(ctx.vk, 0, 0, &baseChannels);
+    const std::vector<float> normal =
+        m_voxelizer->volumes().normal.readbackFloat(ctx.vk, 0, 0, &normalChannels);
+    const size_t voxels = flux.size();
+    if (albedo.size() < voxels * albedoChannels || base.size() < voxels * baseChannels ||
+        normal.size() < voxels * normalChannels || albedoChannels < 3 || baseChannels < 3 ||
+        normalChannels < 3)
+        return;
+    const double v0 = m_grid.voxelSize();
+    double photons = 0.0, volume = 0.0;
+    size_t lit = 0;
+    for (size_t i = 0; i < voxels; ++i) {
+        const float* a = &albedo[i * albedoChannels];
+        photons +=
+            (double(a[0]) * flux[i].x + double(a[1]) * flux[i].y + double(a[2]) * flux[i].z) / 3.0;
+        const float* b = &base[i * baseChannels];
+        const double l = (double(b[0]) + b[1] + b[2]) / 3.0;
+        if (!(l > 0.0)) continue;
+        ++lit;
+        const float* nv = &normal[i * normalChannels];
+        const glm::dvec3 m(nv[0], nv[1], nv[2]);
+        const double len = glm::length(m);
+        const double l1 = len > 0.1 ? (std::abs(m.x) + std::abs(m.y) + std::abs(m.z)) / len : 1.0;
+        volume += std::numbers::pi * l * v0 * v0 / l1;
+    }
+    ctx.stat("power_photons_reflected_w", photons);
+    ctx.stat("power_volume_w", volume);
+    ctx.stat("power_volume_over_photons", photons > 0.0 ? volume / photons : 0.0);
+    ctx.stat("lit_base_voxels", double(lit));
 }
 
 void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) {

@@ -44,6 +44,8 @@ public:
     void setup(TechniqueContext& ctx) override;
     UpdateKind update(TechniqueContext& ctx, const SceneChanges& changes) override;
     void render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTargets& targets) override;
+    /** power_stats: the photons' and the base volume's power (a diagnostic, after the frame). */
+    void frameFinished(TechniqueContext& ctx) override;
     std::vector<DebugView> debugViews() override;
 
     /** Introspection for tests (valid after setup). */
@@ -59,6 +61,7 @@ private:
     VoxelGrid m_grid;
     bool m_octree = false;
     bool m_ao = false;
+    bool m_powerStatsDue = false;  // power_stats: read the volumes after the next frame
     std::unique_ptr<Voxelizer> m_voxelizer;
     std::unique_ptr<vct::LightInjection> m_injection;
     std::unique_ptr<VoxelRadiance> m_radiance;
