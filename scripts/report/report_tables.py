@@ -219,10 +219,6 @@ def _frame_cell(run: Run) -> tuple[str, object]:
     shown = time_with_bar(frame.median, frame.iqr)
     if frame.source == "cpu":
         shown += ' <span class="pm">(CPU clock)</span>'
-    shared, own = run.anim.dynamic_shared.median, run.anim.dynamic_technique.median
-    if shared is not None and own is not None:
-        shown += (f' <span class="pm">(shared passes {shared:.3g} ms, technique {own:.3g} ms)'
-                  '</span>')
     return shown, frame.median
 
 
