@@ -51,8 +51,8 @@ std::vector<std::string> withVariants(const fs::path& file) {
     return out;
 }
 
-/** Every shipped scene description (scenes, scenes/stress: *.json) with its variants. */
-std::vector<std::string> shippedScenes() {
+/** Every shipped scene file (scenes, scenes/stress: *.json), sorted per folder. */
+std::vector<std::string> shippedSceneFiles() {
     std::vector<std::string> out;
     for (const fs::path& dir : {scenesDir(), scenesDir() / "stress"}) {
         std::vector<fs::path> files;
@@ -60,9 +60,17 @@ std::vector<std::string> shippedScenes() {
             if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path());
         std::sort(files.begin(), files.end());
         for (const fs::path& f : files)
-            for (const std::string& s : withVariants(f))
-                out.push_back(s);
+            out.push_back(f.string());
     }
+    return out;
+}
+
+/** Every shipped scene description with its variants. */
+std::vector<std::string> shippedScenes() {
+    std::vector<std::string> out;
+    for (const std::string& f : shippedSceneFiles())
+        for (const std::string& s : withVariants(f))
+            out.push_back(s);
     return out;
 }
 
@@ -192,20 +200,6 @@ Json rowJson(const Row& r) {
 }
 
 }  // namespace
-
-/** The shipped scene files (their base variants) for --placements. */
-std::vector<std::string> shippedSceneFiles() {
-    std::vector<std::string> out;
-    for (const fs::path& dir : {scenesDir(), scenesDir() / "stress"}) {
-        std::vector<fs::path> files;
-        for (const fs::directory_entry& e : fs::directory_iterator(dir))
-            if (e.is_regular_file() && e.path().extension() == ".json") files.push_back(e.path());
-        std::sort(files.begin(), files.end());
-        for (const fs::path& f : files)
-            out.push_back(f.string());
-    }
-    return out;
-}
 
 double percentile(std::vector<double> v, double q) {
     if (v.empty()) return std::nan("");
