@@ -3,7 +3,7 @@
 counts (issue 43; docs/techniques/vct.md "Energy against the grid resolution").
 
 Usage: /usr/bin/python3 scripts/vct_energy_table.py results/vct_resolution_control
-(the runs of experiments/configs/vct_resolution_control.json). Energy = mean of the run's
+(the runs of experiments/configs/vct_resolution_control.json or vct_mip_control.json). Energy = mean of the run's
 indirect layer over the reference's bounce-1 mean (metrics.final_vs_bounces 1 minus 0).
 """
 import glob
@@ -30,7 +30,10 @@ def main(folder):
         one = ladder["1"]["reference_mean"] - ladder["0"]["reference_mean"]
         params = run["technique"]["params"]
         control = params.get("control_level0_rays", 0)
-        series = f"control {control} rays" if control else f"cones, lift {params['lift']}"
+        # At aperture 0 the control reads level max(lod_offset - 1, 0) (vct_mip_control.json)
+        level = max(int(round(params.get("lod_offset", 0) - 1)), 0)
+        series = (f"control {control} rays, level {level}" if control
+                  else f"cones, lift {params['lift']}")
         stats = run.get("stats", {})
         energy = indirect_mean(path.rsplit("/", 1)[0]) / one if one > 0 else float("nan")
         rows.setdefault((run["scene"]["label"], series), {})[params["voxel_resolution"]] = (

@@ -743,6 +743,17 @@ TEST_F(GpuShadowTest, CornellBoxPunctualLightsMatchRayCastVisibility) {
     expectClean(compareWithRayCast(f, s), f, "spot + point + directional");
 }
 
+// The cascade blend band (shared.shadow_cascade_blend, issue 43 item 4) mixes two cascades'
+// visibilities only where they disagree: away from shadow edges both are exact, so the
+// ray-cast check holds at the widest band too (a wrong "next" map would break it).
+TEST_F(GpuShadowTest, CascadeBlendBandKeepsVisibilityExactAwayFromEdges) {
+    Scene s = cornellWithPunctualLights();
+    SharedPassSettings settings;
+    settings.shadow.cascadeBlend = 0.5f;
+    Frame f = render(s, s.camera, settings);
+    expectClean(compareWithRayCast(f, s), f, "spot + point + directional, blend 0.5");
+}
+
 TEST_F(GpuShadowTest, CornellBoxEmitterSamplesMatchRayCastVisibility) {
     Scene s = makeCornellBox(CornellBoxParams{});
     s.computeCaps();

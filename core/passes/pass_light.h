@@ -38,7 +38,8 @@ struct PassLight {
                                    // z normal offset (texels), w PCF radius
     glm::vec4 surfaceBias{0.0f};   // surface receivers (the direct pass): the same four
     glm::vec4 cascades{0.0f};      // x first cascade entry, y count (directional lights),
-                                   // z 1 = receiver-plane test for surface receivers
+                                   // z 1 = receiver-plane test for surface receivers,
+                                   // w the cascade blend band (ShadowSettings::cascadeBlend)
     glm::vec4 origin{0.0f};        // orthographic: a point on the entry plane
     glm::mat4 viewProj{1.0f};      // 2D maps: world -> Vulkan clip space
 };

@@ -71,6 +71,8 @@ ShadowMaps::ShadowMaps(vk::Context& ctx, vk::GpuScene& scene, const ShadowSettin
     if (settings.pcfRadius < 0) throw Error("ShadowSettings: pcfRadius must be >= 0");
     if (!(settings.cascadeSplit >= 0.0f && settings.cascadeSplit <= 1.0f))
         throw Error("ShadowSettings: cascadeSplit must be in [0, 1]");
+    if (!(settings.cascadeBlend >= 0.0f && settings.cascadeBlend <= 0.5f))
+        throw Error("ShadowSettings: cascadeBlend must be in [0, 0.5]");
     if (!(aspect > 0.0f) || !std::isfinite(aspect))
         throw Error("ShadowMaps: the frame's aspect ratio must be positive");
     buildLightTable(scene, areaLightSamples);
@@ -122,7 +124,8 @@ PassLight ShadowMaps::sceneLightEntry(const Light& l, uint32_t index, ShadowKind
     light.bias = kVolumeShadowBias;
     light.surfaceBias = glm::vec4(m_settings.constantBias, m_settings.slopeBias,
                                   m_settings.normalOffset, float(m_settings.pcfRadius));
-    light.cascades = glm::vec4(0.0f, 0.0f, m_settings.receiverPlane ? 1.0f : 0.0f, 0.0f);
+    light.cascades =
+        glm::vec4(0.0f, 0.0f, m_settings.receiverPlane ? 1.0f : 0.0f, m_settings.cascadeBlend);
     const glm::vec3 dir(light.direction);
     light.positionType.w = float(l.type == LightType::Point  ? kPassLightPoint
                                  : l.type == LightType::Spot ? kPassLightSpot

@@ -61,6 +61,8 @@ struct ShadowSettings {
     uint32_t cascades = 4;          // view-fitted maps per directional light (0 = none)
     float cascadeSplit = 0.5f;      // split scheme: 0 uniform, 1 logarithmic
     bool cascadeSnap = true;        // stable cascade texels (shadow_cascades.h CascadeSettings)
+    float cascadeBlend = 0.0f;      // band at each cascade's border, a fraction of its half-size,
+                                    // where the visibility fades into the next cascade's
     bool enabled = true;            // false: no maps at all, visibility = 1
 };
 

@@ -40,6 +40,10 @@ std::vector<ParamSpec> sharedPassParamSpecs() {
                   "Cascade sizes in quarter-octave steps and centres on whole texels, so the "
                   "texel grid stays put when the camera moves (off: refit exactly, edges crawl)",
                   ParamStage::Rebuild),
+        floatParam("shadow_cascade_blend", d.cascadeBlend, 0.0, 0.5, "",
+                   "Band at each cascade's border (fraction of its half-size) where a receiver's "
+                   "visibility fades linearly into the next cascade's (0 = a hard switch)",
+                   ParamStage::Rebuild),
         intParam("area_light_samples", int(s.areaLightSamples), 0, 4096, "",
                  "Virtual point lights standing in for emissive surfaces in the direct pass "
                  "(0 = emitters light nothing directly)",
@@ -74,6 +78,7 @@ SharedPassSettings sharedSettingsFromParams(const ParamSet& p) {
     s.shadow.cascades = uint32_t(p.getInt("shadow_cascades"));
     s.shadow.cascadeSplit = p.getFloat("shadow_cascade_split");
     s.shadow.cascadeSnap = p.getBool("shadow_cascade_snap");
+    s.shadow.cascadeBlend = p.getFloat("shadow_cascade_blend");
     s.areaLightSamples = uint32_t(p.getInt("area_light_samples"));
     s.areaLightAnalytic = p.getBool("area_light_analytic");
     const double res = double(s.shadow.areaResolution);

@@ -22,6 +22,7 @@
 #include "core/util/strings.h"
 #include "core/vk/context.h"
 #include "experiments/cli/cli.h"
+#include "experiments/cli/leak_causes.h"
 #include "experiments/cli/light_placements.h"
 #include "experiments/cli/run_metadata.h"
 #include "experiments/metrics/direct_accuracy.h"
@@ -107,6 +108,7 @@ struct Row {
     double referenceRelError = 0.0;  // mean relative standard error of the reference's layers
     uint64_t referenceSpp = 0;
     double directMs = 0.0, directIqr = 0.0, shadowSetupMs = 0.0;
+    Image raster, reference;  // emission + direct of both, kept for the leak classification
 };
 
 Row benchLoaded(vk::Context& ctx, const Scene& scene, const std::string& label,
@@ -177,7 +179,27 @@ Row benchLoaded(vk::Context& ctx, const Scene& scene, const std::string& label,
     row.rasterMean = meanLuminance(raster);
     row.flip = metrics::computeHdrFlip(raster, reference, metrics::kDefaultPpd).stats.mean;
     row.status = "ok";
+    row.raster = raster;
+    row.reference = reference;
     return row;
+}
+
+/** The measured causes of a row's leak (leak_causes.h) where its scene is lit by one point or
+ *  spot light and nothing else; nullopt otherwise. */
+std::optional<std::string> leakCauseText(const Scene& scene, const Image& raster,
+                                         const Image& reference,
+                                         const BenchDirectOptions& options) {
+    if (scene.lights.size() != 1 || scene.caps.hasEmissive ||
+        scene.lights[0].type == LightType::Directional)
+        return std::nullopt;
+    ParamSet params = TechniqueRegistry::instance().defaultParams("direct");
+    ParamSet shared = defaultSharedParams();
+    applyAssignments(options.assignments, params, shared);
+    const SharedPassSettings settings = sharedSettingsFromParams(shared);
+    ShadowModel model;
+    model.resolution = settings.shadow.resolution;
+    model.constantBias = settings.shadow.constantBias;
+    return describeLeakCauses(classifyLeaks(scene, raster, reference, model));
 }
 
 Json rowJson(const Row& r) {
@@ -232,6 +254,8 @@ int runPlacements(vk::Context& ctx, const BenchDirectOptions& options,
         std::vector<double> leaks, energies;
         double worstLeak = -1.0;
         std::string worst;
+        std::optional<Scene> worstScene;
+        Image worstRaster, worstReference;
         for (size_t k = 0; k < placements.size(); ++k) {
             const Scene lit = withOnlyLight(scene, placements[k].light);
             const std::string label = spec + " [" + std::to_string(k) + "]";
@@ -249,6 +273,9 @@ int runPlacements(vk::Context& ctx, const BenchDirectOptions& options,
             if (100.0 * r.accuracy.shadowLeak > worstLeak) {
                 worstLeak = 100.0 * r.accuracy.shadowLeak;
                 worst = placements[k].label;
+                worstScene = lit;
+                worstRaster = r.raster;
+                worstReference = r.reference;
             }
             if (!options.quiet)
                 std::printf("%-48s %-7.4f %7.3f %%  %s\n", label.c_str(), r.accuracy.energyRatio,
@@ -265,8 +292,14 @@ int runPlacements(vk::Context& ctx, const BenchDirectOptions& options,
             spec.c_str(), leaks.size(), median, p95, energy,
             *std::min_element(energies.begin(), energies.end()),
             *std::max_element(energies.begin(), energies.end()), worstLeak, worst.c_str());
+        // The worst placement's measured cause (leak_causes.h)
+        const std::string causeText =
+            leakCauseText(*worstScene, worstRaster, worstReference, options)
+                .value_or("not classified");
+        std::printf("%-48s worst placement's leak: %s\n", "", causeText.c_str());
         std::fflush(stdout);
         summaries.push_back({{"scene", spec},
+                             {"worst_leak_causes", causeText},
                              {"placements", leaks.size()},
                              {"leak_median_percent", median},
                              {"leak_p95_percent", p95},
@@ -324,6 +357,14 @@ int runBenchDirect(const BenchDirectOptions& options) {
                         r.size.c_str(), r.lights.c_str(), r.accuracy.energyRatio,
                         100.0 * r.accuracy.shadowLeak, 100.0 * r.accuracy.missing, r.flip,
                         r.directMs, r.shadowSetupMs);
+            if (r.accuracy.shadowLeak > 1e-3) {
+                Scene scene = loadScene(spec);
+                applyResolutionOverride(scene, options.resolution);
+                if (const auto text = leakCauseText(scene, r.raster, r.reference, options)) {
+                    std::printf("%-48s leak: %s\n", "", text->c_str());
+                    rows.back()["leak_causes"] = *text;
+                }
+            }
         } else {  // nothing reaches the camera in the path tracer: the raster's light is a leak
             std::printf(
                 "%-48s %-8s %-14s %7s %8s %8s %8.4f %9.2f %10.1f  black reference; "

@@ -93,6 +93,7 @@ void main() {
         vec3 c = triangleGeometricNormal(uint(material.w) - 1u);
         float len = length(c);
         if (len > 0.0) ng = c / len;
+        if (dot(ng, wo) < 0.0) ng = -ng;  // the side the viewer sees (as n, gbuffer.frag)
     }
 
     // Sum f * E * V over the lights; the emitter samples are gathered apart (area lights)
@@ -105,6 +106,9 @@ void main() {
         vec3 ePerp = lightIrradiancePerp(light, x, wi, dist);
         float cosTheta = dot(n, wi);
         if (cosTheta <= 0.0 || all(equal(ePerp, vec3(0.0)))) continue;
+        // A light behind the seen side of the triangle reaches it through the surface only: a
+        // smooth shading normal may still face it (the path tracer's rule, integrator.cpp)
+        if (dot(ng, wi) < 0.0) continue;
         bool isSample = i >= pc.areaLights.x;
         if (isSample) areaUnoccluded += ePerp * cosTheta;
         float visibility = pc.sizeLights.w != 0u ? shadowVisibilitySurface(i, x, n, ng, wi) : 1.0;

@@ -222,9 +222,24 @@ float shadowVisibilitySurface(uint index, vec3 x, vec3 n, vec3 ng, vec3 wi) {
     bool plane = light.cascades.z > 0.5 && dot(ng, ng) > 0.0;
     uint first = uint(light.cascades.x);
     uint count = uint(light.cascades.y);
+    float band = light.cascades.w;
     for (uint k = 0u; k < count; ++k) {
-        float v = shadowLookup(passLights[first + k], x, n, ng, wi, settings, plane, true);
-        if (v >= 0.0) return v;
+        PassLight c = passLights[first + k];
+        float v = shadowLookup(c, x, n, ng, wi, settings, plane, true);
+        if (v < 0.0) continue;
+        // Blend band (shared.shadow_cascade_blend): within `band` of the half-size from the
+        // cascade's border, fade into the next cascade that holds x (else the light's own map),
+        // so a receiver crossing the border changes gradually instead of switching texel grids
+        vec4 clip = c.viewProj * vec4(x, 1.0);
+        float edge = clip.w > 0.0 ? 1.0 - max(abs(clip.x), abs(clip.y)) / clip.w : 1.0;
+        if (band > 0.0 && edge < band) {
+            float next = -1.0;
+            for (uint j = k + 1u; j < count && next < 0.0; ++j)
+                next = shadowLookup(passLights[first + j], x, n, ng, wi, settings, plane, true);
+            if (next < 0.0) next = shadowLookup(light, x, n, ng, wi, settings, plane, false);
+            v = mix(next, v, clamp(edge / band, 0.0, 1.0));
+        }
+        return v;
     }
     return shadowLookup(light, x, n, ng, wi, settings, plane, false);
 }
