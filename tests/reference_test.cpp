@@ -23,6 +23,7 @@
 #include "core/util/error.h"
 #include "reference/bsdf.h"
 #include "reference/integrator.h"
+#include "reference/light_power.h"
 #include "reference/lights.h"
 #include "reference/path_tracer.h"
 #include "reference/sampling.h"
@@ -1263,6 +1264,57 @@ TEST(CpuReferenceThroughput, DISABLED_CornellAndSponza) {
     } catch (const Error& e) {
         std::printf("sponza not available: %s\n", e.what());
     }
+}
+
+}  // namespace
+}  // namespace gilab::ref
+
+namespace gilab::ref {
+namespace {
+
+/** A 2 x 2 floor (albedo 0.5) and one light. */
+Scene floorUnder(const Light& light) {
+    Scene s;
+    s.name = "floor";
+    s.sourcePath = "<test>";
+    Material m;
+    m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
+    s.materials.push_back(m);
+    appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, 0);
+    s.lights.push_back(light);
+    s.computeCaps();
+    return s;
+}
+
+// `gilab bench light-power` (issue 43's control for what voxels hold): known fluxes.
+TEST(CpuLightPower, PointSpotAndSunFluxesMatchTheirClosedForms) {
+    Light point;
+    point.type = LightType::Point;
+    point.position = {0.0f, 1.0f, 0.0f};
+    point.intensity = glm::vec3(2.0f);
+    // A point light 1 above a 2 x 2 floor: the floor subtends 2 pi / 3 sr (the solid angle of
+    // a square of half-side a at height h: 4 asin(a^2 / (a^2 + h^2)) = 4 asin(1 / 2))
+    ref::LightPower p = ref::punctualLightPower(floorUnder(point), 1u << 18).front();
+    EXPECT_NEAR(p.emittedW, 2.0 * 4.0 * kPiD, 1e-3);
+    EXPECT_NEAR(p.incidentW, 2.0 * 4.0 * std::asin(0.5), 2e-3 * p.incidentW);
+    EXPECT_NEAR(p.reflectedW, 0.5 * p.incidentW, 1e-9 * p.incidentW);
+    // A spot with a hard 30-degree cone pointing down: all of it lands on the floor
+    Light spot = point;
+    spot.type = LightType::Spot;
+    spot.direction = {0.0f, -1.0f, 0.0f};
+    spot.innerConeRad = spot.outerConeRad = float(kPiD / 6.0);
+    p = ref::punctualLightPower(floorUnder(spot), 1u << 16).front();
+    const double cone = 2.0 * kPiD * (1.0 - std::cos(kPiD / 6.0));
+    EXPECT_NEAR(p.incidentW, 2.0 * cone, 1e-3 * p.incidentW);
+    EXPECT_NEAR(p.emittedW, p.incidentW, 1e-9 * p.incidentW);
+    // A sun straight down with E = 3 W/m^2: the floor's 4 m^2
+    Light sun;
+    sun.type = LightType::Directional;
+    sun.direction = {0.0f, -1.0f, 0.0f};
+    sun.intensity = glm::vec3(3.0f);
+    p = ref::punctualLightPower(floorUnder(sun), 1u << 18).front();
+    EXPECT_NEAR(p.incidentW, 12.0, 0.01 * 12.0);
+    EXPECT_NEAR(p.reflectedW, 6.0, 0.01 * 6.0);
 }
 
 }  // namespace

@@ -355,6 +355,16 @@ int runMain(int argc, char** argv) {
     benchDirectCmd->add_option("--out,-o", benchDirect.outDir, "Also write bench_direct.json here");
     benchDirectCmd->add_flag("--quiet,-q", benchDirect.quiet, "No progress lines");
 
+    BenchLightPowerOptions benchPower;
+    CLI::App* benchPowerCmd = bench->add_subcommand(
+        "light-power",
+        "Each punctual light's emitted, incident and reflected power (albedo x flux at the first "
+        "hit), traced with Embree: what vct's photons and cvgi's lit voxels should hold");
+    benchPowerCmd->add_option("--scene", benchPower.scenes, "Scene (repeatable)")->required();
+    benchPowerCmd->add_option("--rays", benchPower.rays, "Rays per light")
+        ->check(CLI::Range(1u, 1u << 30))
+        ->capture_default_str();
+
     exp::RunnerOptions run;
     run.commandLine = commandLine;
     std::string shard;
@@ -493,6 +503,7 @@ int runMain(int argc, char** argv) {
         if (*ref) return runReference(reference);
         if (*benchRefCmd) return runBenchReference(benchRef);
         if (*benchDirectCmd) return runBenchDirect(benchDirect);
+        if (*benchPowerCmd) return runBenchLightPower(benchPower);
         if (*benchTechCmd) {
             for (const std::string& t : benchTech.techniques)
                 checkTechniqueName(t);

@@ -82,6 +82,14 @@ struct BenchTechniqueOptions {
 };
 int runBenchTechnique(const BenchTechniqueOptions& options);
 
+/** `gilab bench light-power`: each punctual light's emitted, incident and reflected power,
+ *  traced with Embree (reference/light_power.h): what a voxel volume's lit power should be. */
+struct BenchLightPowerOptions {
+    std::vector<std::string> scenes;
+    uint32_t rays = 1u << 20;  // per light
+};
+int runBenchLightPower(const BenchLightPowerOptions& options);
+
 /** `gilab bench direct`: the shared direct light against the path tracer on every shipped scene
  *  (docs/shared_passes.md, "Accuracy"). */
 struct BenchDirectOptions {

@@ -34,29 +34,30 @@ void main() {
     vec3 wi;
     float dist;
     vec3 ePerp = lightIrradiancePerp(light, centre, wi, dist);
-    if (lit && u.options.y != 0u) {
-        // "An occupied neighbor in the light direction" (Fig. 10), read as: the voxel is buried
-        // toward the light on every axis the light comes from (each axis neighbour whose
-        // to-light component exceeds 0.2 is occupied), or the neighbour across its own lit
-        // face (the heuristic normal, when it faces the light) is occupied. The dominant axis
-        // alone rejected every wall voxel lit at an angle: its neighbour along that axis is the
-        // next voxel of the same wall (docs/techniques/cvgi.md, "Lit voxels").
-        bool buried = true;
-        bool any = false;
-        for (int axis = 0; axis < 3; ++axis) {
-            if (abs(wi[axis]) <= 0.2) continue;
-            ivec3 step = ivec3(0);
-            step[axis] = wi[axis] > 0.0 ? 1 : -1;
-            any = true;
-            buried = buried && cvgiIndexAt(c + step) != CVGI_EMPTY;
-        }
-        ivec3 face = cvgiAxisDir(cvgiAxis(i));
-        bool faceCovered = dot(vec3(face), wi) > 0.0 && cvgiIndexAt(c + face) != CVGI_EMPTY;
-        if ((any && buried) || faceCovered) lit = false;
-    }
-    if (!lit) return;
     CvgiVoxel v = voxels[i];
     vec3 n = v.normalCluster.xyz;
+    if (lit && u.options.y != 0u) {
+        // "An occupied neighbor in the light direction" (Fig. 10), read as: the neighbour the
+        // light direction points to (the 26-neighbour c + round(wi)) is occupied and is not
+        // part of this voxel's own surface. A neighbour belongs to the surface when the plane
+        // of the voxel's mean normal n, through a point at most half the way from the centre
+        // to the cube's boundary, also crosses the neighbour's cube: |n.step| < 0.75 |n|_1
+        // (voxel units; the next voxel of the same wall, floor or slope, including the second
+        // voxel of a sloped surface's staircase column). Issue 43: the previous reading
+        // (buried on every axis with |wi_k| > 0.2, or across the heuristic face) rejected
+        // every wall voxel under a steep sun and half of every slope (cvgi held 0.51 of the
+        // reflected power `gilab bench light-power` traces on Sponza's sun; docs/techniques/
+        // cvgi.md, "Lit voxels").
+        ivec3 step = ivec3(round(wi));
+        if (step != ivec3(0) && cvgiIndexAt(c + step) != CVGI_EMPTY) {
+            float len = length(n);
+            vec3 m = len > 0.5 ? n / len : vec3(0.0);
+            float l1 = abs(m.x) + abs(m.y) + abs(m.z);
+            bool ownSurface = len > 0.5 && abs(dot(m, vec3(step))) < 0.75 * l1;
+            if (!ownSurface) lit = false;
+        }
+    }
+    if (!lit) return;
     if (dot(n, n) < 1e-6) n = vec3(cvgiAxisDir(cvgiAxis(i)));
     vec3 b = v.albedoAxis.rgb * ePerp * max(dot(normalize(n), wi), 0.0);
     if (!(b.r + b.g + b.b > 0.0)) return;  // the light does not reach it

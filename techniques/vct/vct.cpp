@@ -130,7 +130,7 @@ TechniqueInfo VctTechnique::describe() {
                    "maximum cone length in units of the voxel grid's side"),
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
                    "cone origin offset along the surface normal, in finest voxels"),
-        floatParam("lod_offset", 0.0, -2.0, 2.0, "levels",
+        floatParam("lod_offset", 0.0, -2.0, 8.0, "levels",
                    "added to the cone's level log2(radius / v0) (Crassin §5: the level of the "
                    "cone radius); -1 = the node-size reading (needs step_factor <= 0.125)"),
         floatParam("lift", 1.5, 0.0, 4.0, "cells",
