@@ -196,9 +196,7 @@ Scene slopeUnderASteepSun() {
     Scene s;
     s.name = "slope_under_a_steep_sun";
     s.sourcePath = "<test>";
-    Material m;
-    m.baseColorFactor = glm::vec4(0.6f, 0.5f, 0.4f, 1.0f);
-    s.materials.push_back(m);
+    appendLambertianMaterial(s, "stone", glm::vec3(0.6f, 0.5f, 0.4f));
     appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, 0);  // floor
     appendQuad(s, {-0.9f, 0.0f, -0.7f}, {-0.1f, 0.8f, -0.7f}, {-0.1f, 0.8f, 0.7f},
                {-0.9f, 0.0f, 0.7f}, {-1, 1, 0}, 0);  // slope
@@ -220,11 +218,9 @@ Scene slopeUnderASteepSun() {
 /** The slope scene with only surface `keep` (0 floor, 1 slope, 2 wall) reflecting light. */
 Scene onlySurface(int keep) {
     Scene s = slopeUnderASteepSun();
-    Material black;
-    black.baseColorFactor = glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
-    s.materials.push_back(black);
+    const uint32_t black = appendLambertianMaterial(s, "black", glm::vec3(0.0f));
     for (size_t t = 0; t < s.triangleMaterials.size(); ++t)
-        if (int(t / 2) != keep) s.triangleMaterials[t] = 1;
+        if (int(t / 2) != keep) s.triangleMaterials[t] = black;
     s.name += keep == 1 ? " (slope)" : " (wall)";
     return s;
 }

@@ -1277,9 +1277,7 @@ Scene floorUnder(const Light& light) {
     Scene s;
     s.name = "floor";
     s.sourcePath = "<test>";
-    Material m;
-    m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
-    s.materials.push_back(m);
+    appendLambertianMaterial(s, "grey", glm::vec3(0.5f));
     appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, 0);
     s.lights.push_back(light);
     s.computeCaps();

@@ -437,9 +437,7 @@ Scene lightBehindTheSeenSide() {
     Scene s;
     s.name = "light_behind_the_seen_side";
     s.sourcePath = "<test>";
-    Material m;
-    m.baseColorFactor = glm::vec4(0.5f, 0.5f, 0.5f, 1.0f);
-    s.materials.push_back(m);
+    appendLambertianMaterial(s, "grey", glm::vec3(0.5f));
     appendQuad(s, {-1, 0, -1}, {1, 0, -1}, {1, 0, 1}, {-1, 0, 1}, {0, 1, 0}, 0);
     for (Vertex& v : s.vertices)
         v.normal = glm::normalize(glm::vec3(1.0f, 0.2f, 0.0f));

@@ -2,6 +2,7 @@
 // with Embree (reference/light_power.h), the control for the power a voxel volume holds
 // (docs/techniques/vct.md, "Energy against the grid resolution").
 #include <cstdio>
+#include <vector>
 
 #include "core/scene/scene_loader.h"
 #include "experiments/cli/cli.h"
@@ -10,10 +11,15 @@
 namespace gilab::cli {
 
 int runBenchLightPower(const BenchLightPowerOptions& options) {
+    std::vector<Scene> scenes;  // every scene loads (or fails with its error) before any output
+    for (const std::string& spec : options.scenes)
+        scenes.push_back(loadScene(spec));
     std::printf("%-40s %-20s %12s %12s %12s %10s\n", "scene", "light", "emitted W", "incident W",
                 "reflected W", "rays");
-    for (const std::string& spec : options.scenes) {
-        const Scene scene = loadScene(spec);
+    for (size_t k = 0; k < scenes.size(); ++k) {
+        const Scene& scene = scenes[k];
+        const std::string& spec = options.scenes[k];
+        if (scene.lights.empty()) std::printf("%-40s (no punctual light)\n", spec.c_str());
         if (scene.caps.hasEmissive)
             std::printf("%-40s (emissive triangles are not counted)\n", spec.c_str());
         for (const ref::LightPower& p : ref::punctualLightPower(scene, options.rays))
