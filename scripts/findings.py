@@ -3,7 +3,7 @@
 
     /usr/bin/python3 scripts/findings.py results/study [--audit results/audit/audit.json]
         [--out docs/findings.md] [--glance docs/findings_glance.md]
-        [--budgets 50,200,1000] [--fractions 0.9,0.75,0.6,0.45]
+        [--budgets 50,200,1000] [--fractions 0.9,0.75,0.6,0.45] [--allow-dirty]
 
 Reads runs/<key>/result.json like the report (scripts/report/report_data.py), analyses them with
 scripts/report/report_study.py (series, Pareto fronts, equal-time and equal-error tables with
@@ -31,7 +31,12 @@ import matplotlib  # noqa: E402
 matplotlib.use("agg")
 import report_study as S  # noqa: E402
 from report_analysis import slug  # noqa: E402
-from report_study_html import md_breaks, md_table, series_colors, study_figure  # noqa: E402
+from report_study_html import (md_breaks, md_table, md_verdict, series_colors,  # noqa: E402
+                               study_figure)
+
+class DirtyError(RuntimeError):
+    pass
+
 
 PNG_SIZE = (6.0, 4.0)  # inches at PNG_DPI: 600 x 400 px
 PNG_DPI = 100
@@ -49,23 +54,44 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                    "to --out)")
     p.add_argument("--budgets", default=",".join(f"{b:g}" for b in S.BUDGETS_MS),
                    help="equal-time budgets, ms, comma-separated")
+    p.add_argument("--allow-dirty", action="store_true",
+                   help="write a draft from uncommitted code or runs (its top says so); "
+                   "without it findings are written only from a clean commit")
     p.add_argument("--fractions", default=",".join(f"{f:g}" for f in S.ERROR_FRACTIONS),
                    help="equal-error targets as fractions of the direct floor")
     return p.parse_args(argv)
 
 
-def git_commit() -> str:
-    """HEAD of the repository holding this script, '-dirty' when tracked files changed."""
+def git_commit(own_outputs: tuple[str, ...] = ()) -> str:
+    """HEAD of the repository holding this script, '-dirty' when tracked files changed; the
+    findings' own outputs (own_outputs: files or folders) do not count, so rewriting
+    docs/findings.md does not make the next findings dirty."""
     repo = os.path.dirname(HERE)
     try:
         head = subprocess.run(["git", "-C", repo, "rev-parse", "HEAD"], capture_output=True,
                               text=True, timeout=20).stdout.strip()
-        dirty = subprocess.run(["git", "-C", repo, "status", "--porcelain",
-                                "--untracked-files=no"], capture_output=True, text=True,
-                               timeout=20).stdout.strip()
+        status = subprocess.run(["git", "-C", repo, "status", "--porcelain",
+                                 "--untracked-files=no"], capture_output=True, text=True,
+                                timeout=20).stdout.splitlines()
     except (OSError, subprocess.SubprocessError):
         return "unknown"
+    own = [os.path.abspath(p) for p in own_outputs]
+    dirty = [line for line in status if line.strip() and not any(
+        os.path.abspath(os.path.join(repo, line[3:].strip())) == o
+        or os.path.abspath(os.path.join(repo, line[3:].strip())).startswith(o + os.sep)
+        for o in own)]
     return (head or "unknown") + ("-dirty" if head and dirty else "")
+
+
+def dirty_reasons(commit: str, run_commits: list[str]) -> list[str]:
+    """Why these findings would not be from a clean commit ([]: they are)."""
+    out = []
+    if commit.endswith("-dirty"):
+        out.append(f"the source tree has uncommitted changes ({commit})")
+    bad = [c for c in run_commits if c.endswith("-dirty")]
+    if bad:
+        out.append(f"runs were made by a build with uncommitted changes ({', '.join(bad)})")
+    return out
 
 
 def experiment_info(results: str) -> dict:
@@ -81,12 +107,40 @@ def _fmt_list(values: list[float]) -> str:
     return ", ".join(f"{v:g}" for v in values) or "—"
 
 
+def caveats_md(study: "S.Study") -> list[str]:
+    """What the numbers are and are not (issue 44): the device, the image sizes, what each
+    technique's static frame holds."""
+    sizes: dict[str, set[str]] = {}
+    for r in study.rows:
+        if r.get("resolution"):
+            sizes.setdefault(S.fstr(r.get("resolution")), set()).add(S.fstr(r.get("scene")))
+    md = ["## Caveats", "",
+          f"- **Device.** Every time is on {study.device} ({study.machine}). "
+          + ("Lavapipe is Mesa's CPU Vulkan driver on a 2-core machine, not a GPU: it favours "
+             "per-scene fixed costs over per-pixel ones, and a budget in its milliseconds is "
+             "not a GPU's. Equal-time verdicts hold for this device only; equal-error and "
+             "matched-basis verdicts do not depend on it."
+             if "lavapipe" in study.device else "Equal-time verdicts hold for this device only."),
+          "- **Image sizes.** " + ("; ".join(f"{k}: {', '.join(sorted(v))}"
+                                            for k, v in sorted(sizes.items()))
+                                  or "not recorded") + ". Per-pixel costs grow with the image; "
+          "a fixed cost does not.",
+          "- **Static frame.** The frame time is the static frame: the G-buffer, the shared "
+          "direct light and the technique's per-frame passes, after its set-up (docs/timing.md). "
+          "What that holds differs per technique:"]
+    for tech, facts in sorted(S.PF.load_all().items()):
+        if facts.static_frame and any(s.partition(" (")[0] == tech for s in study.series):
+            md.append(f"  - {tech}: {facts.static_frame}.")
+    return md + [""]
+
+
 def ladders_md(study: "S.Study") -> list[str]:
     """Each series' rungs, cheapest first (median frame time over the static scenes), the
     paper's marked: what the curves are made of."""
     md = ["## The ladders", "",
           "Each series' settings, cheapest first by the median static frame time over the scenes "
-          "it ran on; ◆ = the paper's settings (`report_study.PAPER_RUNGS`). Why these knobs and "
+          "it ran on; ◆ = the paper rung (`techniques/<id>/paper.json`: the paper's settings with "
+          "the paper's value of each design choice). Why these knobs and "
           "values: docs/experiments.md, \"The study\".", "",
           "| series | rungs (median frame time) |", "|---|---|"]
     for s in study.series:
@@ -110,7 +164,7 @@ def ladders_md(study: "S.Study") -> list[str]:
 
 def write_findings(results: str, out: str, glance_path: str, audit: str | None,
                    budgets: tuple[float, ...], fractions: tuple[float, ...],
-                   argv: list[str]) -> tuple[str, str, list[str]]:
+                   argv: list[str], allow_dirty: bool = False) -> tuple[str, str, list[str]]:
     bad: list[str] = []
     all_rows = S.load_rows([results], bad)
     for b in bad:
@@ -121,14 +175,26 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
     study = S.analyse(rows, budgets, fractions, S.load_audit(audit))
     out_dir = os.path.dirname(os.path.abspath(out))
     fig_dir = os.path.join(out_dir, "findings")
+    commit = git_commit((out, glance_path, fig_dir))
+    dirty = dirty_reasons(commit, study.commits)
+    if dirty and not allow_dirty:
+        raise DirtyError("; ".join(dirty))
     os.makedirs(fig_dir, exist_ok=True)
     colors = series_colors(study.series)
     info = experiment_info(results)
     total = info.get("runs_total")
     date = datetime.datetime.now(datetime.timezone.utc).strftime("%Y-%m-%d %H:%M UTC")
     command = "/usr/bin/python3 scripts/findings.py " + " ".join(argv)
-    md = ["# Findings of the cross-technique study", "",
-          f"- commit `{git_commit()}` (the runs: {', '.join(study.commits) or 'unknown'})",
+    md = ["# Findings of the cross-technique study", ""]
+    if dirty:
+        md += [f"**Draft (--allow-dirty): {'; '.join(dirty)}.** Findings are written from a "
+               "clean commit; these are not.", ""]
+    if not all_rows:
+        md += ["No finished runs yet.", ""]
+    md += md_verdict(study)
+    md += caveats_md(study)
+    md += ["## Provenance", "",
+          f"- commit `{commit}` (the runs: {', '.join(study.commits) or 'unknown'})",
           f"- device: {study.device}; machine: {study.machine}",
           f"- date: {date}",
           f"- regenerate: `{command}`"
@@ -144,8 +210,6 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
           "- rules (ties, targets, leaks): docs/report.md, \"Cross-technique study\"; "
           f"budgets {_fmt_list(list(budgets))} ms; equal-error targets "
           f"{_fmt_list(list(fractions))} × the direct floor.", ""]
-    if not all_rows:
-        md += ["No finished runs yet.", ""]
     md += ladders_md(study)
     md += ["## Reference noise and the direct floor", "",
            "Direct floor: the `direct` run's HDR-FLIP vs the full reference (all indirect light "
@@ -217,7 +281,7 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
                       + f" | {S.sig3(g['floor_ratio']) if g['floor_ratio'] is not None else '—'}"
                       + f" | {wins or '—'} | {', '.join(g['breaks']) or '—'} |")
     glance.append("")
-    glance.append(f"Timed on {study.device}, {study.machine}; commit `{git_commit()}`, {date}; "
+    glance.append(f"Timed on {study.device}, {study.machine}; commit `{commit}`, {date}; "
                   f"from {os.path.basename(out)} (`{command}`).")
     with open(glance_path, "w", encoding="utf-8") as f:
         f.write("\n".join(glance) + "\n")
@@ -242,8 +306,14 @@ def main(argv: list[str]) -> int:
         audit = default if os.path.isfile(default) else None
     glance = args.glance or os.path.join(os.path.dirname(os.path.abspath(args.out)),
                                          "findings_glance.md")
-    out, glance, pngs = write_findings(args.results, args.out, glance, audit, budgets,
-                                       fractions, argv)
+    try:
+        out, glance, pngs = write_findings(args.results, args.out, glance, audit, budgets,
+                                           fractions, argv, args.allow_dirty)
+    except DirtyError as e:
+        print(f"findings: not written: {e}. Findings are written only from a clean commit: "
+              "commit (and rebuild and rerun what changed) first, or pass --allow-dirty for a "
+              "draft that says so.", file=sys.stderr)
+        return 2
     print(out)
     print(glance)
     for p in pngs:

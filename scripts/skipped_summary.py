@@ -4,7 +4,8 @@
 A GoogleTest skip prints "<file>:<line>: Skipped" and then its message; a script test that
 exits 77 (SKIP_RETURN_CODE) prints its own reason. Tests are grouped by the first line of the
 message, so "shared scenes not found" is counted once with the number of tests it skipped.
-Usage: skipped_summary.py <build>/Testing/Temporary/LastTest.log
+Usage: skipped_summary.py LOG [LOG...]  (ctest's <build>/Testing/Temporary/LastTest.log of each
+ctest call; scripts/test.sh makes two: the fast tests two at a time, then the slow ones)
 """
 import re
 import sys
@@ -30,13 +31,15 @@ def skipped_tests(text):
     return out
 
 
-def main(path):
-    try:
-        text = open(path, encoding="utf-8", errors="replace").read()
-    except OSError as e:
-        print(f"skipped tests: cannot read {path}: {e.strerror}")
-        return 0
-    tests = skipped_tests(text)
+def main(paths):
+    tests = []
+    for path in paths:
+        try:
+            text = open(path, encoding="utf-8", errors="replace").read()
+        except OSError as e:
+            print(f"skipped tests: cannot read {path}: {e.strerror}")
+            continue
+        tests += skipped_tests(text)
     if not tests:
         print("skipped tests: none")
         return 0
@@ -51,6 +54,6 @@ def main(path):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 2:
+    if len(sys.argv) < 2:
         sys.exit(__doc__)
-    sys.exit(main(sys.argv[1]))
+    sys.exit(main(sys.argv[1:]))

@@ -14,4 +14,6 @@ out="$(GILAB_REPORT_SCRIPT= "$tmp/prefix/bin/gilab" report results/empty 2>&1)" 
     echo "$out"; exit 1; }
 test -f results/empty/report.html
 test -f "$tmp/prefix/share/gilab/report/make_report.py"
+# The paper facts the report reads (issue 44), beside it.
+test -f "$tmp/prefix/share/gilab/techniques/vct/paper.json"
 echo "install ok: $tmp/prefix/bin/gilab"

@@ -117,6 +117,7 @@ div.reason { color: #555; font-size: 11px; min-width: 150px; max-width: 240px; }
 .pm { color: var(--muted); font-size: 11px; }
 td.best { font-weight: 700; background: #fff3c4 !important; }
 table.data.study td.tie { background: #fff9e0 !important; }
+table.data.study td.comp { background: #fde8e8 !important; text-decoration: line-through; }
 table.data.study td.flag { color: #b3261e; font-weight: 600; }
 table.data.study tr.winners td { border-top: 1px solid #ccc; font-size: 11px; }
 .filter { margin: 6px 0; font-size: 13px; }

@@ -761,6 +761,15 @@ def study_html(page: Page) -> str:
     return "".join(blocks)
 
 
+def verdict_html(page: Page) -> str:
+    """The first screen's verdict table of the first device model's study ('' without one)."""
+    from report_study_html import series_colors, verdict_screen_html
+
+    for study in page.study[:1]:
+        return verdict_screen_html(study, series_colors(study.series, page.colors))
+    return ""
+
+
 def render_page(page: Page) -> str:
     sections = [invalid_banner_html(page), study_html(page), equal_html(page), scenes_html(page),
                 animation_html(page), run_table_html(page) + failures_html(page),
@@ -778,5 +787,5 @@ def render_page(page: Page) -> str:
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
             f"<title>{esc(title)}</title><style>{CSS}</style><script>{HEAD_JS}</script></head>"
-            f"<body>{header_html(page)}<nav>{nav}</nav>{body}{footer_html(page)}"
+            f"<body>{header_html(page, verdict_html(page))}<nav>{nav}</nav>{body}{footer_html(page)}"
             f"{inspector_html(page)}<script>{BODY_JS}{INSPECTOR_JS}</script></body></html>\n")

@@ -1,15 +1,17 @@
 """Noise rules: when two runs can be told apart, and what a front or a trend may claim.
 
-A run's frame time is the interval [q1, q3] (its interquartile range over the timed frames; the
-median alone when the quartiles are missing); an error is [value − σ, value + σ] with σ the
-metric's error bar (1σ from the reference's noise; 0 when the metric has none). Two values are
-*separable* when their intervals do not overlap. A difference that is not separable is never
-called better, worse, a trend or a ranking: it is a tie (docs/report.md, "Noise").
+The rules are verdicts.py's, the same as the study's: two errors are *separable* when
+|e_a − e_b| > sqrt(σ_a² + σ_b²) (σ the metric's 1σ error bar from the reference's noise; 0 when
+the metric has none); two frame times when |t_a − t_b| > sqrt(h_a² + h_b²), h the half-width of
+each run's interquartile range over its timed frames (0 without quartiles). A difference that is
+not separable is never called better, worse, a trend or a ranking: it is a tie (docs/report.md,
+"Noise").
 """
 from __future__ import annotations
 
 from typing import Callable, Optional
 
+import verdicts as V
 from report_data import Run
 
 Metric = Callable[[Run], Optional[float]]
@@ -38,30 +40,29 @@ def time_interval(run: Run) -> tuple[float, float]:
     return min(lo, median), max(hi, median)
 
 
-def value_interval(value: float, sigma: Optional[float]) -> tuple[float, float]:
-    s = abs(sigma) if sigma is not None else 0.0
-    return value - s, value + s
-
-
-def overlap(a: tuple[float, float], b: tuple[float, float]) -> bool:
-    return a[0] <= b[1] and b[0] <= a[1]
-
-
 def clearly_lower(a: float, a_sigma: Optional[float], b: float, b_sigma: Optional[float]
                   ) -> bool:
-    """a < b beyond both error bars."""
-    return value_interval(a, a_sigma)[1] < value_interval(b, b_sigma)[0]
+    """a < b beyond the noise of the difference (verdicts.error_bound's rule)."""
+    return b - a > V.error_bound(V.Entry("", "", None, a, error_sigma=abs(a_sigma or 0.0)),
+                                 V.Entry("", "", None, b, error_sigma=abs(b_sigma or 0.0)))
+
+
+def _time_entry(run: Run) -> V.Entry:
+    lo, hi = time_interval(run)
+    t = run.frame_ms if run.frame_ms is not None else 0.0
+    return V.Entry("", "", t, 0.0, time_spread=(hi - lo) / 2.0 / t if t > 0 else 0.0)
 
 
 def time_separable(a: Run, b: Run) -> bool:
-    return not overlap(time_interval(a), time_interval(b))
+    return not V.time_tie(_time_entry(a), _time_entry(b))
 
 
 def error_separable(a: Run, b: Run, error: Metric, sigma: Metric) -> bool:
     ea, eb = error(a), error(b)
     if ea is None or eb is None:
         return True
-    return not overlap(value_interval(ea, sigma(a)), value_interval(eb, sigma(b)))
+    return not V.error_tie(V.Entry("", "", None, ea, error_sigma=abs(sigma(a) or 0.0)),
+                           V.Entry("", "", None, eb, error_sigma=abs(sigma(b) or 0.0)))
 
 
 def inseparable(a: Run, b: Run, error: Metric, sigma: Metric) -> bool:

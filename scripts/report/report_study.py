@@ -20,6 +20,8 @@ import statistics
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Optional
 
+import paper_facts as PF
+import verdicts as V
 from report_data import dig
 
 # ------------------------------------------------------------------------------------------------
@@ -45,28 +47,24 @@ TEMPORAL_FACTOR = 1.5
 # error there is a leak; they are left out of the findings' winners and the glance table.
 NOT_QUALITY = (LEAK_CLOSED,)
 THIN_WALL_CASES = ("thin_wall", "light_through_wall")  # audit cases shown (name prefixes)
-# The paper's settings of each technique, as rung values of its ladder. A row is a paper rung
-# when every listed parameter has the listed value. vct: Table 1's 3 cones at 256^3, the
-# largest grid lavapipe holds (the paper's 512^3 octree does not fit, docs/techniques/vct.md);
-# dvs: the source repository's 256^3 and 6 cones; cvgi: 128^3 and 128 rays per face (its
-# Tables 1-4); ssvp: Table I's N1 = 256, C = 8, N2 = 256; topovpl: Table I's 1024 VPLs, 256^3.
-PAPER_RUNGS: dict[str, dict[str, object]] = {  # by technique
-    "vct": {"voxel_resolution": 256, "diffuse_cones": 3},
-    "dvs": {"voxel_resolution": 256, "diffuse_cones": 6, "bounces": 1},
-    "cvgi": {"gather": "paper", "voxel_resolution": 128, "rays_per_face": 128},
-    "ssvp": {"first_bounce_vpls": 256, "clusters": 8, "second_bounce_vpls": 256},
-    "topovpl": {"voxel_resolution": 256, "vpls": 1024},
-}
-# Our choices (not the paper's) and the paper's alternative: findings ask whether a winner
-# changes when only the paper's variant is allowed.
-# (technique, our settings, the paper's as printed): experiments/configs/study.json runs both.
-OUR_CHOICES: list[tuple[str, dict[str, object], dict[str, object]]] = [
-    ("cvgi", {"gather": "ray_weighted"}, {"gather": "paper"}),
-    ("vct", {"lift": 1.5}, {"lift": 0}),
-    ("ssvp", {"weights": "physical"}, {"weights": "paper"}),
-    ("topovpl", {"cluster_merge": "visible", "gate_placement": "bottleneck", "gate_radius": "neck"},
-     {"cluster_merge": "none", "gate_placement": "midpoint", "gate_radius": "min"}),
-]
+# Paper facts (the paper rung, our choices against the paper's) come from each technique's
+# techniques/<id>/paper.json (paper_facts.py); none is typed here.
+
+
+def paper_rungs() -> dict[str, dict[str, object]]:
+    """technique -> its paper rung (paper_facts.PaperFacts.paper_rung)."""
+    return {t: f.paper_rung for t, f in PF.load_all().items()}
+
+
+def our_choices() -> list[tuple[str, dict[str, object], dict[str, object]]]:
+    """(technique, our values, the paper's values) of each technique's design choices, together:
+    findings ask whether a winner changes when only the paper's variant is allowed."""
+    out = []
+    for t, f in PF.load_all().items():
+        if f.design_choices:
+            out.append((t, {c.param: c.ours for c in f.design_choices},
+                        {c.param: c.paper for c in f.design_choices}))
+    return out
 
 
 def _same_value(a: object, b: object) -> bool:
@@ -85,7 +83,9 @@ def series_params(series: str) -> tuple[str, dict[str, str]]:
 
 
 def our_choice_pairs(series: Iterable[str]) -> list[tuple[str, str]]:
-    """(our series, the paper's series) of each OUR_CHOICES entry that the study ran both of."""
+    """(our series, the paper's series) of each our_choices() entry that the study ran both of:
+    the series whose series parameters hold every one of our values, and the one that holds
+    every one of the paper's."""
     def find(tech: str, want: dict[str, object]) -> Optional[str]:
         for s in series:
             t, ps = series_params(s)
@@ -93,7 +93,7 @@ def our_choice_pairs(series: Iterable[str]) -> list[tuple[str, str]]:
                 return s
         return None
     out = []
-    for tech, ours, paper in OUR_CHOICES:
+    for tech, ours, paper in our_choices():
         a, b = find(tech, ours), find(tech, paper)
         if a and b:
             out.append((a, b))
@@ -176,6 +176,8 @@ def row_from_result(data: dict) -> dict:
         "frame_cpu_ms_median": dig(d, "timing", "frame_cpu_ms", "median"),
         "frame_cpu_ms_iqr": dig(d, "timing", "frame_cpu_ms", "iqr"),
         "reference_samples": dig(d, "reference", "samples"),
+        "resolution": "x".join(str(v) for v in dig(d, "scene", "resolution") or []) or None,
+        "memory_total_bytes": dig(d, "memory", "total_bytes"),
         "reference_matched": dig(d, "reference", "matched"),
         "energy_ratio": dig(d, "metrics", "energy_ratio"),
         "direct.energy_ratio": dig(d, "metrics", "direct", "energy_ratio"),
@@ -191,6 +193,9 @@ def row_from_result(data: dict) -> dict:
     for prefix, path in (("full", "final_vs_full"), ("matched", "final"),
                          ("indirect", "indirect"), ("direct", "direct")):
         _metric_columns(row, prefix, dig(d, "metrics", path))
+    # The bounce floors: the exact 0/1/2-bounce images against the full reference.
+    for b in FLOOR_BOUNCES:
+        _metric_columns(row, f"floor{b}", dig(d, "metrics", "bounce_floors", str(b)))
     nonfinite = d.get("nonfinite")
     if isinstance(nonfinite, dict):
         row["nan_pixels"] = sum(fnum(dig(c, "nan_pixels")) or 0 for c in nonfinite.values())
@@ -290,6 +295,11 @@ def load_rows(dirs: list[str], unreadable: Optional[list[str]] = None) -> list[d
 # Parameters that never change the image (caches, diagnostics): runs that differ only in them
 # belong to one series (topovpl's topology_cache = off times the cold set-up, docs/report.md).
 NOT_SERIES_KEYS = {"topology_cache", "same_cluster_stat"}
+# Parameters whose runs are repeats of one configuration: a technique's sampling seed (the error
+# spread it causes) and a repeat index (timing). Their runs are pooled into one point (means)
+# and give the pooled seed and time spreads of verdicts.py.
+REPEAT_KEYS = {"seed", "repeat"}
+FLOOR_BOUNCES = (0, 1, 2)
 
 
 def cached_setup(row: dict) -> bool:
@@ -319,7 +329,8 @@ def series_keys(rows: list[dict]) -> dict[str, list[str]]:
     for r in rows:
         tech = fstr(r.get("technique"))
         for k, v in _params(r).items():
-            if k not in ladders.get(tech, set()) and k not in NOT_SERIES_KEYS:
+            if (k not in ladders.get(tech, set()) and k not in NOT_SERIES_KEYS
+                    and k not in REPEAT_KEYS):
                 values.setdefault((tech, fstr(r.get("scene")), k), set()).add(v)
     out: dict[str, set[str]] = {}
     for (tech, _, k), vs in values.items():
@@ -344,11 +355,11 @@ def rung_text(row: dict, ladders: dict[str, set[str]]) -> str:
 
 def is_paper_rung(row: dict, series: str) -> Optional[bool]:
     """Whether the run is at the paper's settings (None: no paper rung defined)."""
-    rung = PAPER_RUNGS.get(series.partition(" (")[0])
+    rung = paper_rungs().get(series.partition(" (")[0])
     if rung is None:
         return None
     ps = _params(row)
-    return all(fstr(ps.get(k)) == fstr(v) for k, v in rung.items())
+    return all(k in ps and _same_value(ps[k], v) for k, v in rung.items())
 
 
 def animated_scene(rows: list[dict]) -> bool:
@@ -359,7 +370,8 @@ def animated_scene(rows: list[dict]) -> bool:
 
 @dataclass
 class Point:
-    """One run of a series on a scene."""
+    """One configuration of a series on a scene (its seed / repeat runs pooled into one: mean
+    time and error, REPEAT_KEYS)."""
 
     row: dict
     series: str
@@ -372,6 +384,8 @@ class Point:
     rung: str = ""
     paper: Optional[bool] = None
     cpu_clock: bool = False  # x is a CPU-clock time (no timestamps)
+    repeats: int = 1  # runs pooled into this point
+    entry: V.Entry = field(default_factory=lambda: V.Entry("", "", None, None))
 
     @property
     def ranked(self) -> bool:
@@ -380,6 +394,15 @@ class Point:
     @property
     def key(self) -> str:
         return fstr(self.row.get("key"))
+
+    @property
+    def compensating(self) -> bool:
+        return self.entry.compensating
+
+
+def _bounces(row: dict) -> Optional[int]:
+    b = fnum(row.get("bounces"))
+    return None if b is None else int(b)
 
 
 def make_point(row: dict, series: str, animated: bool, ladders: dict[str, set[str]]) -> Point:
@@ -393,34 +416,106 @@ def make_point(row: dict, series: str, animated: bool, ladders: dict[str, set[st
     sigma = None
     if y is None:
         y, sigma = fnum(row.get("full.flip")), fnum(row.get("full.flip_noise"))
-    return Point(row=row, series=series, status=fstr(row.get("status")) or "?", x=x, x_iqr=iqr,
-                 y=y, y_sigma=sigma, y2=fnum(row.get("indirect.rel_mse")),
-                 rung=rung_text(row, ladders), paper=is_paper_rung(row, series), cpu_clock=cpu)
+    p = Point(row=row, series=series, status=fstr(row.get("status")) or "?", x=x, x_iqr=iqr,
+              y=y, y_sigma=sigma, y2=fnum(row.get("indirect.rel_mse")),
+              rung=rung_text(row, ladders), paper=is_paper_rung(row, series), cpu_clock=cpu)
+    p.entry = _entry(p)
+    return p
+
+
+def _entry(p: Point) -> V.Entry:
+    """The verdict rules' view of a point (verdicts.Entry); spreads are set by analyse()."""
+    b = _bounces(p.row)
+    floor = floor_sigma = None
+    if b is not None and b in FLOOR_BOUNCES:
+        floor, floor_sigma = (fnum(p.row.get(f"floor{b}.flip")),
+                              fnum(p.row.get(f"floor{b}.flip_noise")))
+    return V.Entry(key=p.key, series=p.series, time=p.x if p.ranked else None,
+                   error=p.y if p.ranked else None, error_sigma=p.y_sigma or 0.0,
+                   matched=fnum(p.row.get("matched.flip")),
+                   matched_sigma=fnum(p.row.get("matched.flip_noise")) or 0.0,
+                   bounces=b, floor=floor, floor_sigma=floor_sigma or 0.0)
+
+
+def _config_key(row: dict) -> tuple:
+    """What makes runs repeats of one configuration: scene, technique and every parameter but
+    REPEAT_KEYS."""
+    return (fstr(row.get("scene")), fstr(row.get("technique")),
+            tuple(sorted((k, v) for k, v in _params(row).items() if k not in REPEAT_KEYS)))
+
+
+def pool_repeats(points: list[Point]) -> list[Point]:
+    """One point per configuration: its repeats' mean time and error (the first run's row).
+    A configuration with a failed repeat keeps that failure's status."""
+    groups: dict[tuple, list[Point]] = {}
+    for i, p in enumerate(points):
+        repeat = any(k in _params(p.row) for k in REPEAT_KEYS)  # else never pooled
+        groups.setdefault((p.series,) + _config_key(p.row) + (() if repeat else (i,)),
+                          []).append(p)
+    out = []
+    for pts in groups.values():
+        if len(pts) == 1:
+            out.append(pts[0])
+            continue
+        bad = [p for p in pts if p.status != "ok"]
+        p = bad[0] if bad else pts[0]
+        if not bad:
+            xs = [q.x for q in pts if q.x is not None]
+            ys = [q.y for q in pts if q.y is not None]
+            p = Point(**{**p.__dict__, "x": statistics.fmean(xs) if xs else None,
+                         "y": statistics.fmean(ys) if ys else None, "repeats": len(pts)})
+            p.entry = _entry(p)
+            for attr in ("matched", "floor"):  # means of the repeats too
+                vals = [getattr(q.entry, attr) for q in pts if getattr(q.entry, attr) is not None]
+                setattr(p.entry, attr, statistics.fmean(vals) if vals else None)
+        out.append(p)
+    return out
+
+
+def noise_spreads(rows: list[dict]) -> tuple[dict[str, float], dict[str, float]]:
+    """Per technique: the pooled relative between-run spread of the static frame time and the
+    pooled spread of the full-basis HDR-FLIP, over groups of runs that differ only in
+    REPEAT_KEYS (verdicts.pooled_relative_spread / pooled_spread). A technique with no repeats
+    is absent (its spread is unmeasured: 0 in the rules, said in the report)."""
+    times: dict[str, dict[tuple, list[float]]] = {}
+    errors: dict[str, dict[tuple, list[float]]] = {}
+    for r in rows:
+        if fstr(r.get("status")) != "ok":
+            continue
+        tech, key = fstr(r.get("technique")), _config_key(r)
+        t = fnum(r.get("frame_gpu_ms_median"))
+        if t is None:
+            t = fnum(r.get("frame_cpu_ms_median"))
+        if t is not None:
+            times.setdefault(tech, {}).setdefault(key, []).append(t)
+        if "seed" in _params(r) or any(k in _params(r) for k in REPEAT_KEYS):
+            e = fnum(r.get("full.flip"))
+            if e is not None:
+                errors.setdefault(tech, {}).setdefault(key, []).append(e)
+    time_spread = {t: v for t, g in times.items()
+                   if (v := V.pooled_relative_spread(g.values())) is not None}
+    seed_spread = {t: v for t, g in errors.items()
+                   if (v := V.pooled_spread(g.values())) is not None}
+    return time_spread, seed_spread
 
 
 # ------------------------------------------------------------------------------------------------
-# Rules
+# Rules: verdicts.py defines them; these adapt its verdicts to the tables' columns
 # ------------------------------------------------------------------------------------------------
 def pareto(points: list[Point]) -> list[Point]:
-    """The ranked points no other point beats in both respects (time <= and error <, or
-    time < and error <=); sorted by time."""
-    ranked = [p for p in points if p.ranked]
-    front = [p for p in ranked if not any(
-        (q.x <= p.x and q.y < p.y) or (q.x < p.x and q.y <= p.y) for q in ranked)]
-    return sorted(front, key=lambda p: (p.x, p.y))
+    """verdicts.pareto over the ranked points; sorted by time."""
+    by_entry = {id(p.entry): p for p in points if p.ranked}
+    return [by_entry[id(e)] for e in V.pareto(p.entry for p in points if p.ranked)]
 
 
 def error_tie(a: Point, best: Point) -> bool:
-    """a's error is within the error bars of best's: |e_a - e_best| <= sqrt(σ_a² + σ_best²)
-    (σ = 0 where not recorded, so then only equal errors tie)."""
-    bound = math.hypot(a.y_sigma or 0.0, best.y_sigma or 0.0)
-    return abs(a.y - best.y) <= bound
+    """verdicts.error_tie: |e_a - e_best| <= sqrt(σ_a² + σ_best² + seed spreads²)."""
+    return V.error_tie(a.entry, best.entry)
 
 
 def time_tie(a: Point, best: Point) -> bool:
-    """a's frame time is within the timing IQRs of best's: |t_a - t_best| <= (IQR_a +
-    IQR_best) / 2 (the two centred IQR intervals overlap)."""
-    return abs(a.x - best.x) <= ((a.x_iqr or 0.0) + (best.x_iqr or 0.0)) / 2.0
+    """verdicts.time_tie: within the pooled relative time spreads of both."""
+    return V.time_tie(a.entry, best.entry)
 
 
 @dataclass
@@ -430,21 +525,7 @@ class Cell:
     point: Optional[Point] = None
     best: bool = False  # the column's best
     tie: bool = False  # not the best but inseparable from it
-
-
-def _mark(cells: dict[str, Cell], value, tie) -> list[str]:
-    """Marks the best and the ties of one column; returns the winners (best first, then ties,
-    by name)."""
-    have = {s: c for s, c in cells.items() if c.point is not None}
-    if not have:
-        return []
-    best_name = min(have, key=lambda s: (value(have[s].point), have[s].point.x, s))
-    best = have[best_name].point
-    have[best_name].best = True
-    ties = sorted(s for s, c in have.items() if s != best_name and tie(c.point, best))
-    for s in ties:
-        have[s].tie = True
-    return [best_name] + ties
+    compensating: bool = False  # would beat the best, but by an energy error (never the best)
 
 
 @dataclass
@@ -454,27 +535,36 @@ class Column:
     cells: dict[str, Cell] = field(default_factory=dict)  # series -> cell
     winners: list[str] = field(default_factory=list)  # best first, then the ties
     by_time: bool = False  # ranked by time (equal error) instead of by error (equal time)
+    borderline: bool = False  # the winner could change within the timing or error noise
+    borderline_why: list[str] = field(default_factory=list)
+    compensating: list[str] = field(default_factory=list)  # would win, but compensate
+    matched_winner: Optional[str] = None  # the winner on the bounce-matched basis
 
     def rank(self, cells: dict[str, Cell]) -> list[str]:
-        """Marks the best and the ties among `cells` by this column's measure."""
-        if self.by_time:
-            return _mark(cells, lambda p: p.x, time_tie)
-        return _mark(cells, lambda p: p.y, error_tie)
+        """The winners among `cells` (verdicts.verdict on their points)."""
+        series = {s: [c.point] for s, c in cells.items() if c.point is not None}
+        return V.verdict({s: [p.entry for p in ps] for s, ps in series.items()}, self.limit,
+                         self.by_time).winners
 
 
 def _columns(series_points: dict[str, list[Point]], limits: Iterable[float],
              by_time: bool) -> list[Column]:
-    """One column per limit: each series' best ranked point within it (equal time: the lowest
-    error with time <= the budget; equal error: the least time with error <= the target)."""
+    """One column per limit from verdicts.verdict (equal time: the lowest error with time <=
+    the budget; equal error: the least time with error <= the target)."""
     out = []
+    by_entry = {id(p.entry): p for pts in series_points.values() for p in pts}
+    entries = {s: [p.entry for p in pts if p.ranked] for s, pts in series_points.items()}
     for lim in limits:
         label = f"HDR-FLIP ≤ {sig3(lim)}" if by_time else f"≤ {lim:g} ms"
-        col = Column(label=label, limit=lim, by_time=by_time)
-        for s, pts in series_points.items():
-            ok = [p for p in pts if p.ranked and (p.y if by_time else p.x) <= lim]
-            order = (lambda p: (p.x, p.y)) if by_time else (lambda p: (p.y, p.x))
-            col.cells[s] = Cell(min(ok, key=order) if ok else None)
-        col.winners = col.rank(col.cells)
+        v = V.verdict(entries, lim, by_time)
+        col = Column(label=label, limit=lim, by_time=by_time, winners=v.winners,
+                     borderline=v.borderline, borderline_why=v.borderline_why,
+                     compensating=v.compensating, matched_winner=V.matched_winner(v))
+        for s in series_points:
+            e = v.best.get(s)
+            col.cells[s] = Cell(by_entry[id(e)] if e is not None else None,
+                                best=bool(v.winners) and s == v.winners[0],
+                                tie=s in v.winners[1:], compensating=s in v.compensating)
         out.append(col)
     return out
 
@@ -519,6 +609,12 @@ class SceneStudy:
     rel_mse_noise_floor: Optional[float]  # median full.rel_mse_noise_floor
     flip_floor: Optional[float]  # median full.flip_floor: HDR-FLIP of the noise alone
     device: str
+    # bounces -> HDR-FLIP of the exact image with that many bounces vs the full reference
+    bounce_floors: dict[int, float] = field(default_factory=dict)
+
+    @property
+    def compensating(self) -> list[Point]:
+        return [p for p in self.points if p.ranked and p.compensating]
 
     def best(self, series: str) -> Optional[Point]:
         ranked = [p for p in self.series.get(series, []) if p.ranked]
@@ -563,9 +659,21 @@ def machine_label(rows: list[dict]) -> str:
 
 def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
                   ladders: dict[str, set[str]], budgets: Iterable[float],
-                  fractions: Iterable[float]) -> SceneStudy:
+                  fractions: Iterable[float],
+                  spreads: tuple[dict[str, float], dict[str, float]] = ({}, {})) -> SceneStudy:
     animated = animated_scene(rows)
-    points = [make_point(r, series_name(r, names), animated, ladders) for r in rows]
+    points = pool_repeats([make_point(r, series_name(r, names), animated, ladders)
+                           for r in rows])
+    time_spread, seed_spread = spreads
+    for p in points:
+        tech = fstr(p.row.get("technique"))
+        # Without repeats, the run's own frame-to-frame IQR (as a half-width) stands in for
+        # the between-run spread: a lower bound (runs that should cost the same differed by
+        # 12-29 % between runs, issue 44).
+        own = (p.x_iqr / 2.0 / p.x) if p.x_iqr and p.x else 0.0
+        p.entry.time_spread = time_spread.get(tech, own)
+        p.entry.seed_sigma = seed_spread.get(tech, 0.0)
+    V.flag_compensation([p.entry for p in points if p.ranked])
     series: dict[str, list[Point]] = {}
     for p in sorted(points, key=lambda p: (p.x is None, p.x or 0.0, p.y or 0.0)):
         series.setdefault(p.series, []).append(p)
@@ -575,7 +683,8 @@ def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
     dl = next((p.row for p in baseline), None) or next(
         (r for r in rows if fnum(r.get("direct.flip")) is not None), {})
     return SceneStudy(
-        scene=scene, animated=animated, points=points, series=series, front=pareto(points),
+        scene=scene, animated=animated, points=points, series=series,
+        front=pareto([p for p in points if not p.compensating]),
         equal_time=equal_time(series, budgets),
         equal_error=equal_error(series, error_targets(floor.y if floor else None, fractions)),
         direct_floor=floor, direct_light_flip=fnum(dl.get("direct.flip")),
@@ -586,7 +695,10 @@ def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
         flip_noise=_median([fnum(r.get("full.flip_noise")) for r in rows]),
         rel_mse_noise_floor=_median([fnum(r.get("full.rel_mse_noise_floor")) for r in rows]),
         flip_floor=_median([fnum(r.get("full.flip_floor")) for r in rows]),
-        device=device_name(rows))
+        device=device_name(rows),
+        bounce_floors={b: v for b in FLOOR_BOUNCES
+                       if (v := _median([fnum(r.get(f"floor{b}.flip")) for r in rows]))
+                       is not None})
 
 
 # ------------------------------------------------------------------------------------------------
@@ -771,6 +883,8 @@ class Study:
     rows: list[dict]
     statuses: dict[str, int]
     commits: list[str]
+    time_spread: dict[str, float] = field(default_factory=dict)  # technique -> pooled, relative
+    seed_spread: dict[str, float] = field(default_factory=dict)  # technique -> pooled HDR-FLIP
 
     def scene_best(self, scene: str, series: str) -> Optional[Point]:
         return self.scenes[scene].best(series)
@@ -798,10 +912,11 @@ def analyse(rows: list[dict], budgets: Iterable[float] = BUDGETS_MS,
             audit: Optional[dict[str, list[str]]] = None) -> Study:
     budgets, fractions = tuple(budgets), tuple(fractions)
     names, ladders = series_keys(rows), ladder_keys(rows)
+    spreads = noise_spreads(rows)
     by_scene: dict[str, list[dict]] = {}
     for r in rows:
         by_scene.setdefault(fstr(r.get("scene")) or "?", []).append(r)
-    scenes = {s: analyse_scene(s, rs, names, ladders, budgets, fractions)
+    scenes = {s: analyse_scene(s, rs, names, ladders, budgets, fractions, spreads)
               for s, rs in by_scene.items()}
     series = sorted({p.series for st in scenes.values() for p in st.points},
                     key=lambda s: (not s.startswith(BASELINE), s))
@@ -811,7 +926,8 @@ def analyse(rows: list[dict], budgets: Iterable[float] = BUDGETS_MS,
     study = Study(scenes=scenes, series=series, budgets=budgets, fractions=fractions, breaks=[],
                   device=device_name(rows), machine=machine_label(rows), rows=rows,
                   statuses=statuses,
-                  commits=sorted({fstr(r.get("git_commit")) for r in rows} - {""}))
+                  commits=sorted({fstr(r.get("git_commit")) for r in rows} - {""}),
+                  time_spread=spreads[0], seed_spread=spreads[1])
     study.breaks = breaks(study, audit or {})
     return study
 
@@ -839,15 +955,6 @@ def restricted_winner(col: Column, excluded: str) -> Optional[str]:
     return winners[0] if winners else None
 
 
-def rung_caveat(st: "SceneStudy", ours: str, paper: str) -> str:
-    """'; the paper's variant ran 1 of our 4 rungs' when the comparison is uneven."""
-    n_ours = len({p.rung for p in st.series.get(ours, [])})
-    n_paper = len({p.rung for p in st.series.get(paper, [])})
-    if n_paper >= n_ours:
-        return ""
-    return f"; {paper} ran {n_paper} of the {n_ours} rungs {ours} ran"
-
-
 def findings(study: Study) -> list[str]:
     """Plain sentences, each a restatement of numbers in the tables."""
     out = []
@@ -861,22 +968,26 @@ def findings(study: Study) -> list[str]:
         for col in st.equal_time:
             out.append(f"{scene}, frame time {col.label}: best HDR-FLIP {winners_words(col)}.")
         for ours, paper in our_choice_pairs(study.series):
-            for col in st.equal_time:
+            # Only at matched rungs: our variant's runs at the rungs the paper's variant ran.
+            paper_rungs_run = {p.rung for p in st.series.get(paper, [])}
+            matched = dict(st.series)
+            matched[ours] = [p for p in st.series.get(ours, []) if p.rung in paper_rungs_run]
+            for col in equal_time(matched, study.budgets):
                 if not col.winners or col.winners[0] != ours:
                     continue
                 alt = restricted_winner(col, ours)
                 has_paper = col.cells.get(paper) and col.cells[paper].point is not None
                 if alt is None:
                     out.append(f"{scene}, {col.label}: only {ours} qualifies; without our choice "
-                               "no run would.")
+                               "no run would (at the rungs both variants ran).")
                 elif alt != ours:
                     same = alt.split(" (")[0] == ours.split(" (")[0]
-                    out.append(f"{scene}, {col.label}: {ours} wins; with only {paper} allowed the "
-                               f"winner would be {alt}"
+                    out.append(f"{scene}, {col.label}: {ours} wins at the rungs both variants "
+                               f"ran; with only {paper} allowed the winner would be {alt}"
                                + (" (the same technique still wins)" if same
                                   else " (another technique: our choice changes the ranking)")
                                + ("" if has_paper else f"; {paper} has no run within it")
-                               + rung_caveat(st, ours, paper) + ".")
+                               + ".")
     for s in study.series:
         rows = [(sc, st.best(s), [p for p in st.series.get(s, []) if p.ranked and p.paper])
                 for sc, st in study.scenes.items() if sc not in NOT_QUALITY]
@@ -938,4 +1049,94 @@ def glance(study: Study) -> list[dict]:
         out.append({"technique": tech, "series": series, "best": top,
                     "floor_ratio": statistics.median(ratios) if ratios else None,
                     "wins": wins, "breaks": breaks})
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# The first screen: one technique x budget table on the headline basis, per-scene lines below
+# ------------------------------------------------------------------------------------------------
+DEVICE_CAVEAT = ("budgets are frame times on the device named; lavapipe on a 2-core CPU is not a "
+                 "GPU: it favours per-scene fixed costs over per-pixel ones at these image sizes")
+
+
+@dataclass
+class VerdictCell:
+    """Where one series stands at one budget over the quality scenes."""
+
+    wins: list[str] = field(default_factory=list)  # scenes it wins outright
+    ties: list[str] = field(default_factory=list)  # scenes it ties the winner
+    borderline: list[str] = field(default_factory=list)  # of those, where the verdict is
+    compensating: list[str] = field(default_factory=list)  # scenes it would win by compensating
+
+    def text(self) -> str:
+        parts = []
+        if self.wins:
+            parts.append(f"wins {len(self.wins)}")
+        if self.ties:
+            parts.append(f"ties {len(self.ties)}")
+        if self.borderline:
+            parts.append(f"borderline {len(self.borderline)}")
+        if self.compensating:
+            parts.append(f"compensating {len(self.compensating)}")
+        return ", ".join(parts) or "—"
+
+
+def quality_scenes(study: Study) -> dict[str, SceneStudy]:
+    return {sc: st for sc, st in study.scenes.items() if sc not in NOT_QUALITY}
+
+
+def verdict_table(study: Study) -> dict[str, list[VerdictCell]]:
+    """series -> one cell per budget (study.budgets), over the quality scenes."""
+    out = {s: [VerdictCell() for _ in study.budgets] for s in study.series}
+    for sc, st in quality_scenes(study).items():
+        for i, col in enumerate(st.equal_time):
+            for rank, s in enumerate(col.winners):
+                cell = out[s][i]
+                (cell.wins if rank == 0 else cell.ties).append(sc)
+                if col.borderline:
+                    cell.borderline.append(sc)
+            for s in col.compensating:
+                out[s][i].compensating.append(sc)
+    return out
+
+
+def ladder_reach(study: Study) -> dict[str, tuple[float, float, int]]:
+    """series -> (fastest, slowest frame time, scenes) of its ranked rungs on the quality
+    scenes: what budgets its ladder can reach."""
+    out: dict[str, tuple[float, float, int]] = {}
+    for s in study.series:
+        times = [p.x for st in quality_scenes(study).values() for p in st.series.get(s, [])
+                 if p.ranked]
+        scenes = sum(1 for st in quality_scenes(study).values()
+                     if any(p.ranked for p in st.series.get(s, [])))
+        if times:
+            out[s] = (min(times), max(times), scenes)
+    return out
+
+
+def _column_words(col: Column) -> str:
+    w = ", ".join(col.winners) or "no run qualifies"
+    if len(col.winners) > 1:
+        w = f"{col.winners[0]} (tied: {', '.join(col.winners[1:])})"
+    if col.borderline:
+        w += " [borderline]"
+    if col.compensating:
+        w += f" [compensating, not ranked: {', '.join(col.compensating)}]"
+    if col.matched_winner and col.winners and col.matched_winner != col.winners[0]:
+        w += f" [matched basis: {col.matched_winner}]"
+    return w
+
+
+def scene_lines(study: Study) -> list[str]:
+    """Per quality scene: the time-free verdicts first (equal error, the bounce floors), then
+    equal time; each with its marks."""
+    out = []
+    for sc, st in quality_scenes(study).items():
+        parts = []
+        if st.bounce_floors:
+            parts.append("bounce floors " + ", ".join(f"{b}: {sig3(v)}" for b, v in
+                                                       sorted(st.bounce_floors.items())))
+        parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_error]
+        parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_time]
+        out.append(f"{sc}: " + "; ".join(parts))
     return out

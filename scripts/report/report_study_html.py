@@ -141,8 +141,12 @@ def _sw(s: str, colors: dict[str, str]) -> str:
 def _cell(c: "S.Cell", value: str, tip: str) -> str:
     if c.point is None:
         return "<td>—</td>"
-    cls = ' class="best"' if c.best else (' class="tie"' if c.tie else "")
-    mark = " (best)" if c.best else (" (tie)" if c.tie else "")
+    cls = ' class="best"' if c.best else (' class="tie"' if c.tie else
+                                          (' class="comp"' if c.compensating else ""))
+    mark = " (best)" if c.best else (" (tie)" if c.tie else
+                                     (" (compensating)" if c.compensating else ""))
+    if c.compensating:
+        tip += "; compensating: " + "; ".join(c.point.entry.compensation)
     return f'<td{cls} title="{_e(tip)}" data-key="{_e(c.point.key)}">{value}{mark}</td>'
 
 
@@ -164,11 +168,15 @@ def _table(columns: list["S.Column"], series: list[str], colors: dict[str, str],
                               c.cells[s].point else "")
                         for c in columns)
         rows.append(f"<tr><td>{_sw(s, colors)}</td>{cells}</tr>")
-    winners = "".join(f"<td>{_e(', '.join(c.winners) or '—')}</td>" for c in columns)
+    winners = "".join(f'<td title="{_e("; ".join(c.borderline_why))}">'
+                      f"{_e(winners_text(c))}</td>" for c in columns)
+    matched = "".join(f"<td>{_e(matched_text(c))}</td>" for c in columns)
     heads = "".join(f"<th>{_e(c.label)}</th>" for c in columns)
     return (f'<table class="data study"><caption class="device-line">{caption}</caption>'
             f"<thead><tr><th>{_e(head)}</th>{heads}</tr></thead><tbody>{''.join(rows)}"
-            f'<tr class="winners"><td>best (and ties)</td>{winners}</tr></tbody></table>')
+            f'<tr class="winners"><td>best (and ties)</td>{winners}</tr>'
+            f'<tr class="matched"><td>best on the matched basis</td>{matched}</tr>'
+            "</tbody></table>")
 
 
 def breaks_table(study: "S.Study", colors: dict[str, str], caption: str, device: str) -> str:
@@ -287,10 +295,30 @@ def study_section_html(study: "S.Study", colors: dict[str, str],
 # ------------------------------------------------------------------------------------------------
 # Markdown (docs/findings.md)
 # ------------------------------------------------------------------------------------------------
+def winners_text(c: "S.Column") -> str:
+    """'a, b (borderline); compensating: c': the column's verdict with its marks."""
+    out = ", ".join(c.winners) or "—"
+    if c.borderline:
+        out += " (borderline)"
+    if c.compensating:
+        out += "; compensating: " + ", ".join(c.compensating)
+    return out
+
+
+def matched_text(c: "S.Column") -> str:
+    """The matched-basis winner, and whether it disagrees with the headline's."""
+    if c.matched_winner is None:
+        return "—"
+    agree = c.winners and c.matched_winner == c.winners[0]
+    return c.matched_winner + ("" if agree else " (differs)")
+
+
 def _md_cell(c: "S.Cell", value: str) -> str:
     if c.point is None:
         return "—"
-    return f"**{value}**" if c.best else (f"{value} (tie)" if c.tie else value)
+    return f"**{value}**" if c.best else (f"{value} (tie)" if c.tie else
+                                          (f"{value} (compensating)" if c.compensating
+                                           else value))
 
 
 def md_table(columns: list["S.Column"], series: list[str], value) -> str:
@@ -302,8 +330,9 @@ def md_table(columns: list["S.Column"], series: list[str], value) -> str:
         out.append(f"| {s} | " + " | ".join(
             _md_cell(c.cells.get(s, S.Cell()), value(c.cells[s].point)
                      if c.cells.get(s) and c.cells[s].point else "—") for c in columns) + " |")
-    out.append("| best (and ties) | " + " | ".join(", ".join(c.winners) or "—"
-                                                  for c in columns) + " |")
+    out.append("| best (and ties) | " + " | ".join(winners_text(c) for c in columns) + " |")
+    out.append("| best on the matched basis | " + " | ".join(matched_text(c) for c in columns)
+               + " |")
     return "\n".join(out) + "\n"
 
 
@@ -345,3 +374,77 @@ def md_breaks(study: "S.Study") -> str:
                          + [f"validation: {x}" for x in b.invalid]) or "—").replace("|", "/")
             + " | " + ("; ".join(b.audit) or "—") + " |")
     return "\n".join(out) + "\n"
+
+
+# ------------------------------------------------------------------------------------------------
+# The first screen (report and findings): the verdict table, then a line per scene
+# ------------------------------------------------------------------------------------------------
+def _noise_words(study: "S.Study", series: str) -> str:
+    tech = series.partition(" (")[0]
+    t, k = study.time_spread.get(tech), study.seed_spread.get(tech)
+    return (f"time ±{100 * t:.0f} %" if t is not None else "time: own IQR") + ", " + \
+        (f"seeds ±{S.sig3(k)}" if k is not None else "seeds: not run")
+
+
+def _reach_words(reach: Optional[tuple[float, float, int]]) -> str:
+    if reach is None:
+        return "—"
+    lo, hi, n = reach
+    return f"{S.sig3(lo)} – {S.sig3(hi)} ms ({n} scene{'' if n == 1 else 's'})"
+
+
+def verdict_screen_html(study: "S.Study", colors: dict[str, str]) -> str:
+    """The first screen's verdict: technique x budget on the full basis, marks, per-scene
+    lines; '' when no quality scene has two ranked series."""
+    table = S.verdict_table(study)
+    reach = S.ladder_reach(study)
+    if not any(c.wins for cells in table.values() for c in cells):
+        return ""
+    heads = "".join(f"<th>≤ {b:g} ms</th>" for b in study.budgets)
+    rows = []
+    for s in study.series:
+        cells = "".join(
+            f'<td class="{"best" if c.wins else ("tie" if c.ties else "")}'
+            f'{" comp" if c.compensating and not c.wins else ""}" title="'
+            + _e("; ".join(x for x in (
+                f"wins: {', '.join(c.wins)}" if c.wins else "",
+                f"ties: {', '.join(c.ties)}" if c.ties else "",
+                f"borderline: {', '.join(c.borderline)}" if c.borderline else "",
+                f"compensating: {', '.join(c.compensating)}" if c.compensating else "") if x))
+            + f'">{_e(c.text())}</td>' for c in table[s])
+        rows.append(f"<tr><td>{_sw(s, colors)}</td>{cells}<td>{_e(_reach_words(reach.get(s)))}"
+                    f"</td><td>{_e(_noise_words(study, s))}</td></tr>")
+    lines = "".join(f"<li>{_e(line)}</li>" for line in S.scene_lines(study))
+    scenes = len(S.quality_scenes(study))
+    return ('<section id="verdict" class="verdict"><h2>Verdict: lowest HDR-FLIP against the full '
+            "reference within each frame-time budget</h2>"
+            f'<table class="data study verdict"><caption class="device-line">over {scenes} '
+            f"scenes; timed on {_e(study.device)}; {_e(S.DEVICE_CAVEAT)}</caption><thead><tr>"
+            f"<th>series</th>{heads}<th>ladder reach</th><th>noise in the rules</th></tr>"
+            f"</thead><tbody>{''.join(rows)}</tbody></table>"
+            '<p class="note">wins / ties: scenes where the series is the best or tied with it '
+            "within the noise (reference error bars, seed spread, time spread); borderline: "
+            "the verdict could change within the timing or error noise; compensating: the "
+            "series would win, but its full-basis error is below the floor of the bounces it "
+            "claims or flips against a rival on the bounce-matched basis, so it is not ranked "
+            "(docs/report.md, \"Verdict rules\").</p>"
+            f'<ul class="scene-verdicts">{lines}</ul></section>')
+
+
+def md_verdict(study: "S.Study") -> list[str]:
+    """The same verdict as Markdown lines (docs/findings.md's first section)."""
+    table = S.verdict_table(study)
+    reach = S.ladder_reach(study)
+    out = ["## Verdict", "",
+           f"Lowest HDR-FLIP against the full reference within each frame-time budget, over "
+           f"{len(S.quality_scenes(study))} scenes; timed on {study.device}; "
+           f"{S.DEVICE_CAVEAT}. Marks: docs/report.md, \"Verdict rules\".", "",
+           "| series | " + " | ".join(f"≤ {b:g} ms" for b in study.budgets)
+           + " | ladder reach | noise in the rules |",
+           "|---|" + "---|" * (len(study.budgets) + 2)]
+    for s in study.series:
+        out.append(f"| {s} | " + " | ".join(c.text() for c in table[s])
+                   + f" | {_reach_words(reach.get(s))} | {_noise_words(study, s)} |")
+    out += ["", "Per scene (time-free verdicts first: equal error, then equal time):", ""]
+    out += [f"- {line}" for line in S.scene_lines(study)]
+    return out + [""]

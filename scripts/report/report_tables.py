@@ -50,7 +50,9 @@ def experiment_name(results: Results) -> str:
     return " + ".join(names)
 
 
-def header_html(page: Page) -> str:
+def header_html(page: Page, verdict: str = "") -> str:
+    """The title, the experiment's description, then `verdict` (the study's first screen), then
+    the provenance table."""
     res = page.results
     runs = res.runs
     rows: list[tuple[str, str]] = []
@@ -88,7 +90,7 @@ def header_html(page: Page) -> str:
     rows.append(("runs", counts_html(page)))
     meta = "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows)
     desc = "".join(f'<p class="lead">{esc(d)}</p>' for d in descriptions)
-    return (f"<header><h1>gilab report — {esc(experiment_name(res))}</h1>{desc}"
+    return (f"<header><h1>gilab report — {esc(experiment_name(res))}</h1>{desc}{verdict}"
             f'<table class="meta">{meta}</table></header>')
 
 

@@ -94,8 +94,10 @@ class EqualError(unittest.TestCase):
     def test_least_time_and_ties(self):
         rows = [row("s", "direct", 5, 1.0),
                 row("s", "a", 100, 0.45, iqr=10), row("s", "a", 300, 0.2, iqr=10, n=2),
-                row("s", "b", 108, 0.48, iqr=6),  # |108 - 100| = 8 <= (10 + 6) / 2: tie
-                row("s", "c", 120, 0.30, iqr=4), row("s", "c", 90, 0.7, iqr=1, n=1),  # 20 > 7
+                # No repeats: each run's IQR half-width is its time spread (verdicts.time_tie):
+                # |105 - 100| = 5 <= hypot(5, 3) = 5.8: tie; |120 - 100| = 20 > hypot(5, 2)
+                row("s", "b", 105, 0.48, iqr=6),
+                row("s", "c", 120, 0.30, iqr=4), row("s", "c", 90, 0.7, iqr=1, n=1),
                 row("s", "d", 60, 0.9)]  # never reaches 0.5
         st = S.analyse(rows, fractions=(0.5, 0.25)).scenes["s"]
         half, quarter = st.equal_error
@@ -133,11 +135,18 @@ class Series(unittest.TestCase):
         self.assertEqual(list(study.scenes["t"].series), ["cvgi (gather=paper)"])
         paper = study.scenes["s"].series["cvgi (gather=paper)"]
         self.assertEqual([p.paper for p in paper], [False, True])  # 128^3, 128 rays is the paper's
-        # Our gather wins at 35 ms; the paper gather alone still puts cvgi first there.
+        # Our gather wins at 35 ms, but at a rung (64^3, 128 rays) the paper gather never ran:
+        # no our-choice claim (issue 44: compare only at matched rungs).
         words = S.findings(study)
-        self.assertTrue(any("s, ≤ 35 ms: cvgi (gather=ray_weighted) wins; with only cvgi "
-                            "(gather=paper) allowed the winner would be cvgi (gather=paper) "
-                            "(the same technique still wins)" in w for w in words), words)
+        self.assertFalse(any("cvgi (gather=ray_weighted) wins" in w for w in words), words)
+        # Once the paper gather runs that rung too, the claim is made at it.
+        rows.append(row("s", "cvgi", 34, 0.65, swept="voxel_resolution rays_per_face",
+                        gather="paper", voxel_resolution=64, rays_per_face=128))
+        words = S.findings(S.analyse(rows, budgets=(35, 1000)))
+        self.assertTrue(any("s, ≤ 35 ms: cvgi (gather=ray_weighted) wins at the rungs both "
+                            "variants ran; with only cvgi (gather=paper) allowed the winner "
+                            "would be cvgi (gather=paper) (the same technique still wins)" in w
+                            for w in words), words)
         self.assertTrue(any("paper rung 0.6 at 50 ms" in w or "paper rung 0.600 at 50.0 ms" in w
                             for w in words) or any("the paper rung is its best" in w
                                                    for w in words), words)
@@ -155,14 +164,15 @@ class Series(unittest.TestCase):
         series = ["vct (lift=0.0)", "vct (lift=1.5)", "ssvp",
                   "topovpl (cluster_merge=none, gate_placement=midpoint, gate_radius=min)",
                   "topovpl (cluster_merge=visible, gate_placement=bottleneck, gate_radius=neck)"]
-        self.assertEqual(S.our_choice_pairs(series), [
-            ("vct (lift=1.5)", "vct (lift=0.0)"),
+        self.assertEqual(sorted(S.our_choice_pairs(series)), [
             ("topovpl (cluster_merge=visible, gate_placement=bottleneck, gate_radius=neck)",
-             "topovpl (cluster_merge=none, gate_placement=midpoint, gate_radius=min)")])
+             "topovpl (cluster_merge=none, gate_placement=midpoint, gate_radius=min)"),
+            ("vct (lift=1.5)", "vct (lift=0.0)")])
         rows = [row("s", "vct", 40, 0.5, lift=1.5), row("s", "vct", 40, 0.7, lift=0.0),
                 row("s", "dvs", 45, 0.6)]
         words = S.findings(S.analyse(rows, budgets=(50,)))
-        self.assertTrue(any("s, ≤ 50 ms: vct (lift=1.5) wins; with only vct (lift=0) allowed "
+        self.assertTrue(any("s, ≤ 50 ms: vct (lift=1.5) wins at the rungs both variants ran; "
+                            "with only vct (lift=0) allowed "
                             "the winner would be dvs" in w for w in words), words)
 
 
@@ -295,7 +305,7 @@ class Findings(unittest.TestCase):
             with open(os.path.join(run, "result.json"), "w") as f:
                 f.write('{"status": "ok", "scene": 3')  # truncated
             out = os.path.join(tmp, "f.md")
-            p = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+            p = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"), "--allow-dirty",
                                 os.path.join(tmp, "results", "study"), "--out", out],
                                capture_output=True, text=True, timeout=120)
             self.assertEqual(p.returncode, 0, p.stderr)
@@ -323,7 +333,7 @@ class Findings(unittest.TestCase):
             with open(os.path.join(results, "experiment.json"), "w") as f:
                 json.dump({"name": "t", "runs_total": 7}, f)
             out = os.path.join(tmp, "docs", "findings.md")
-            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"), "--allow-dirty",
                                    results, "--out", out, "--budgets", "60,200"],
                                   capture_output=True, text=True, timeout=120)
             self.assertEqual(proc.returncode, 0, proc.stderr)
@@ -358,13 +368,13 @@ class Findings(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             os.makedirs(os.path.join(tmp, "r", "runs"))
             out = os.path.join(tmp, "f.md")
-            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"), "--allow-dirty",
                                    os.path.join(tmp, "r"), "--out", out],
                                   capture_output=True, text=True, timeout=60)
             self.assertEqual(proc.returncode, 0, proc.stderr)
             with open(out, encoding="utf-8") as f:
                 self.assertIn("No finished runs yet.", f.read())
-            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"), "--allow-dirty",
                                    os.path.join(tmp, "missing")], capture_output=True, text=True)
             self.assertEqual(proc.returncode, 2)
 
