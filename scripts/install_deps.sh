@@ -11,7 +11,7 @@ PACKAGES=(
     libopenimageio-dev openimageio-tools libopenexr-dev
     libembree-dev libtbb-dev
     libcli11-dev libxxhash-dev
-    python3-matplotlib chromium fonts-dejavu-core
+    python3-matplotlib python3-jinja2 python3-openimageio chromium fonts-dejavu-core
     libgtest-dev libgmock-dev
     slurm-wlm munge  # the cluster tests start a one-node Slurm (docs/cluster.md)
 )

@@ -10,10 +10,15 @@ mkdir -p "$tmp/work/results/empty/runs"
 cd "$tmp/work"
 "$tmp/prefix/bin/gilab" --version | grep -q '^gilab '
 # The report must come from the installed copy, not the source tree.
-out="$(GILAB_REPORT_SCRIPT= "$tmp/prefix/bin/gilab" report results/empty 2>&1)" || {
+out="$(GILAB_REPORT_PACKAGE_DIR= "$tmp/prefix/bin/gilab" report results/empty 2>&1)" || {
     echo "$out"; exit 1; }
 test -f results/empty/report.html
-test -f "$tmp/prefix/share/gilab/report/make_report.py"
+pkg="$tmp/prefix/share/gilab/gilab_report"
+for f in __init__.py __main__.py make.py data.py exr.py findings.py templates/page.html.j2 \
+         templates/header.html.j2 templates/verdict.html.j2 static/report.css static/head.js \
+         static/body.js static/inspector.js; do
+    test -f "$pkg/$f" || { echo "not installed: $pkg/$f"; exit 1; }
+done
 # The paper facts the report reads (issue 44), beside it.
 test -f "$tmp/prefix/share/gilab/techniques/vct/paper.json"
 echo "install ok: $tmp/prefix/bin/gilab"

@@ -22,6 +22,7 @@ struct RsmPush {  // mirrors shaders/common/rsm_pc.glsl
 struct VplPush {  // mirrors rsm_vpls.comp
     glm::vec4 axis;
     uint32_t light, count, first, perspective;
+    glm::vec2 shift;
 };
 
 glm::vec3 row(const glm::mat4& m, int r) {
@@ -184,7 +185,7 @@ void ReflectiveShadowMap::record(VkCommandBuffer cmd, const PassLight& entry, ui
 }
 
 void ReflectiveShadowMap::recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls, uint32_t first,
-                                     uint32_t count) {
+                                     uint32_t count, glm::vec2 shift) {
     if (count == 0) return;
     if (vpls.handle() != m_boundVpls) {  // synchronous submissions: safe to rewrite
         m_set.writeBuffer(4, vpls);
@@ -194,7 +195,7 @@ void ReflectiveShadowMap::recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls
     VkDescriptorSet set = m_set.handle();
     vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, m_vplLayout.handle(), 0, 1, &set,
                             0, nullptr);
-    const VplPush push{m_axis, m_light, count, first, m_perspective ? 1u : 0u};
+    const VplPush push{m_axis, m_light, count, first, m_perspective ? 1u : 0u, shift};
     m_vplLayout.push(cmd, push);
     vk::dispatch1D(cmd, count, 64);
     vk::memoryBarrier(cmd);

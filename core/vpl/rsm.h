@@ -9,7 +9,8 @@
  * §III-A: "shadow map and RSM generation are decoupled"). Layers (RGBA32F, GENERAL after record):
  * position, normal (on the light's side), albedo; background texels are 0.
  *
- * recordVpls() draws n VPLs at the fixed Hammersley points (Eq. 1) with flux in watts from the
+ * recordVpls() draws n VPLs at the fixed Hammersley points (Eq. 1; a technique's `seed` shifts
+ * them toroidally, a Cranley-Patterson rotation) with flux in watts from the
  * texel's area (directional) or solid angle (spot): see shaders/common/rsm_vpls.comp.
  */
 #include <cstdint>
@@ -50,8 +51,11 @@ public:
     static bool supports(const PassLight& light);
     /** Renders the RSM of pass light `light` (whose table entry is `entry`). */
     void record(VkCommandBuffer cmd, const PassLight& entry, uint32_t light);
-    /** Writes `count` VPLs from the last record() to vpls[first ...] (bounce 1, unshadowed). */
-    void recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls, uint32_t first, uint32_t count);
+    /** Writes `count` VPLs from the last record() to vpls[first ...] (bounce 1, unshadowed), at
+     *  the Hammersley points toroidally shifted by `shift` (vpl::cranleyPattersonShift of the
+     *  technique's seed; (0, 0), the default, is the unshifted set). */
+    void recordVpls(VkCommandBuffer cmd, const vk::Buffer& vpls, uint32_t first, uint32_t count,
+                    glm::vec2 shift = glm::vec2(0.0f));
 
     vk::Image& position() { return m_position; }
     vk::Image& normal() { return m_normal; }

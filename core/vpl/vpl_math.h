@@ -65,6 +65,39 @@ inline glm::vec2 hammersley(uint32_t k, uint32_t n) {
     return {float(k) / float(n), radicalInverse(k)};
 }
 
+/** PCG hash (Jarzynski & Olano 2020, "Hash Functions for GPU Rendering", JCGT 9(3)). */
+inline uint32_t pcgHash(uint32_t v) {
+    const uint32_t s = v * 747796405u + 2891336453u;
+    const uint32_t w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
+    return (w >> 22u) ^ w;
+}
+
+/**
+ * The Cranley-Patterson rotation (Cranley & Patterson 1976, "Randomization of number theoretic
+ * methods for multiple integration", SIAM J. Numer. Anal. 13(6)) of a technique's `seed`
+ * parameter: an offset in [0, 1)^2 added modulo 1 to every point of a fixed 2D set (a toroidal
+ * shift: each shifted set is as well distributed as the original, and over random offsets every
+ * point is uniform). Seed 0 is no shift, exactly (the images from before the parameter); any
+ * other seed hashes to 24-bit fractions (exact in float).
+ */
+inline glm::vec2 cranleyPattersonShift(uint32_t seed) {
+    if (seed == 0) return {0.0f, 0.0f};
+    const uint32_t a = pcgHash(seed), b = pcgHash(a ^ 0x9E3779B9u);
+    return {float(a >> 8) * 0x1p-24f, float(b >> 8) * 0x1p-24f};
+}
+
+/** Point u shifted by `shift` modulo 1 (GLSL fract(u + shift), shaders/common/vpl.glsl). */
+inline glm::vec2 toroidalShift(glm::vec2 u, glm::vec2 shift) {
+    glm::vec2 v = u + shift;
+    return v - glm::floor(v);
+}
+
+/** Hammersley point k of n under the Cranley-Patterson rotation `shift` (vpl.glsl
+ *  vplHammersleyShifted); shift (0, 0) is hammersley(k, n) exactly. */
+inline glm::vec2 hammersley(uint32_t k, uint32_t n, glm::vec2 shift) {
+    return toroidalShift(hammersley(k, n), shift);
+}
+
 /** Shirley-Chiu concentric square-to-disk map (uniform in area). */
 inline glm::vec2 concentricDisk(glm::vec2 u) {
     const glm::vec2 o = 2.0f * u - 1.0f;

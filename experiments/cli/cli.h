@@ -161,7 +161,8 @@ int runAuditCommand(audit::AuditOptions options);
 
 /** `gilab run CONFIG`; see experiments/runner/runner.h. */
 int runExperimentCommand(const exp::RunnerOptions& options);
-/** `gilab report DIR...`: runs scripts/report/make_report.py with Debian's python3. */
+/** `gilab report DIR...`: runs `python3 -m gilab_report` (Debian's python3) with the package's
+ * folder on PYTHONPATH. */
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir);
 
 /** `gilab slurm CONFIG`: see experiments/cli/slurm_command.cpp and docs/cluster.md. */

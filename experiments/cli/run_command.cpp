@@ -5,6 +5,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "core/util/build_info.h"
 #include "core/util/error.h"
@@ -50,14 +53,19 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
 }
 
 /**
- * The report code, relative to the running binary: GILAB_REPORT_SCRIPT, else
- * <bin>/../share/gilab/report/make_report.py (installed), else <bin>/../scripts/report/ (a build
- * folder inside the source tree), else the source tree the binary was built from.
+ * The folder holding the report's Python package gilab_report (put on PYTHONPATH, run as
+ * `python3 -m gilab_report`): GILAB_REPORT_PACKAGE_DIR, else <bin>/../share/gilab (installed),
+ * else <bin>/../scripts (a build folder inside the source tree), else the source tree's scripts/
+ * the binary was built from.
  */
-static std::string findReportScript() {
-    if (const char* env = std::getenv("GILAB_REPORT_SCRIPT"); env && *env) {
-        if (!std::filesystem::exists(env))
-            throw Error("report: GILAB_REPORT_SCRIPT=" + std::string(env) + " does not exist");
+static std::string findReportPackageDir() {
+    const auto holdsPackage = [](const std::filesystem::path& dir) {
+        return std::filesystem::exists(dir / "gilab_report" / "__main__.py");
+    };
+    if (const char* env = std::getenv("GILAB_REPORT_PACKAGE_DIR"); env && *env) {
+        if (!holdsPackage(env))
+            throw Error("report: GILAB_REPORT_PACKAGE_DIR=" + std::string(env) +
+                        " holds no gilab_report/__main__.py");
         return env;
     }
     std::error_code ec;
@@ -65,18 +73,18 @@ static std::string findReportScript() {
     std::vector<std::filesystem::path> tried;
     if (!ec) {
         const std::filesystem::path bin = exe.parent_path();
-        tried.push_back(bin / ".." / "share" / "gilab" / "report" / "make_report.py");
-        tried.push_back(bin / ".." / "scripts" / "report" / "make_report.py");
+        tried.push_back(bin / ".." / "share" / "gilab");
+        tried.push_back(bin / ".." / "scripts");
     }
-    tried.push_back(std::filesystem::path(build::kSourceDir) / "scripts" / "report" /
-                    "make_report.py");
+    tried.push_back(std::filesystem::path(build::kSourceDir) / "scripts");
     std::string list;
     for (const auto& p : tried) {
-        if (std::filesystem::exists(p)) return p.lexically_normal().string();
-        list += (list.empty() ? "" : ", ") + p.lexically_normal().string();
+        if (holdsPackage(p)) return p.lexically_normal().string();
+        list += (list.empty() ? "" : ", ") + (p / "gilab_report").lexically_normal().string();
     }
-    throw Error("report: cannot find make_report.py (looked in " + list +
-                "); install with `cmake --install` or set GILAB_REPORT_SCRIPT");
+    throw Error("report: cannot find the report's Python package gilab_report (looked in " + list +
+                "); install with `cmake --install` or set GILAB_REPORT_PACKAGE_DIR to "
+                "the folder holding gilab_report/");
 }
 
 int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
@@ -93,9 +101,9 @@ int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
             (std::filesystem::path(dirs[0]) / "audit.md").c_str());
         return kExitOk;
     }
-    const std::string script = findReportScript();
+    const std::string packageDir = findReportPackageDir();
     const char* python = "/usr/bin/python3";  // Debian's, with python3-matplotlib
-    std::vector<std::string> args{python, script};
+    std::vector<std::string> args{python, "-m", "gilab_report"};
     args.insert(args.end(), dirs.begin(), dirs.end());
     if (!outDir.empty()) {
         args.push_back("--out");
@@ -105,12 +113,35 @@ int runReport(const std::vector<std::string>& dirs, const std::string& outDir) {
     for (std::string& a : args)
         argv.push_back(a.data());
     argv.push_back(nullptr);
+    // The environment with the package's folder first on PYTHONPATH (built before fork)
+    constexpr std::string_view kKey = "PYTHONPATH=";
+    std::vector<std::string> env;
+    std::string pythonPath(kKey);
+    pythonPath.append(packageDir);
+    for (char** e = environ; *e; ++e) {
+        const std::string_view entry = *e;
+        if (entry.starts_with(kKey)) {
+            if (entry.size() > kKey.size()) {
+                pythonPath.push_back(':');
+                pythonPath.append(entry.substr(kKey.size()));
+            }
+        } else {
+            env.emplace_back(entry);
+        }
+    }
+    env.push_back(pythonPath);
+    std::vector<char*> envp;
+    for (std::string& e : env)
+        envp.push_back(e.data());
+    envp.push_back(nullptr);
     std::fflush(stdout);
     const pid_t pid = ::fork();
     if (pid < 0) throw Error("report: cannot start " + std::string(python));
     if (pid == 0) {
-        ::execv(python, argv.data());
-        std::perror("gilab: report: cannot run /usr/bin/python3 (install python3-matplotlib)");
+        ::execve(python, argv.data(), envp.data());
+        std::perror(
+            "gilab: report: cannot run /usr/bin/python3 (scripts/install_deps.sh: "
+            "python3-matplotlib, python3-jinja2, python3-openimageio)");
         std::_Exit(127);
     }
     int status = 0;

@@ -59,14 +59,14 @@ double topLevelGpuMs(const std::vector<const vk::PassTime*>& passes) {
     return total;
 }
 
+}  // namespace
+
 nlohmann::ordered_json summaryJson(const std::vector<double>& values) {
     const Summary s = summarize(values);
     return {{"median", number(s.median)}, {"q1", number(s.q1)},   {"q3", number(s.q3)},
             {"iqr", number(s.iqr())},     {"min", number(s.min)}, {"max", number(s.max)},
             {"samples", values}};
 }
-
-}  // namespace
 
 bool isDiagnosticPass(const std::string& name) {
     const size_t slash = name.find('/');

@@ -27,6 +27,8 @@ bool isDiagnosticPass(const std::string& name);
 double frameGpuIqrOverMedian(const std::vector<FrameTiming>& frames);
 nlohmann::ordered_json deviceJson(const vk::Context& ctx);
 nlohmann::ordered_json sceneToJson(const Scene& scene);
+/** {median, q1, q3, iqr, min, max, samples} of a list of times (ms). */
+nlohmann::ordered_json summaryJson(const std::vector<double>& values);
 /** Setup times, the warm-up, then per-frame CPU and per-pass GPU times as median / IQR over the
  *  frames. */
 nlohmann::ordered_json timingJson(const SetupTiming& setup, const std::vector<FrameTiming>& frames,

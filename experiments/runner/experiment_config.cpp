@@ -17,6 +17,7 @@
 #include "core/technique/registry.h"
 #include "core/util/error.h"
 #include "core/util/json_reader.h"
+#include "experiments/runner/pt_baseline.h"
 
 namespace gilab::exp {
 namespace {
@@ -248,7 +249,7 @@ TechniqueEntry parseTechnique(const JsonNode& node, const std::set<std::string>&
     }
     ParamSet params;
     try {
-        params = TechniqueRegistry::instance().defaultParams(t.id);
+        params = defaultRunParams(t.id);
     } catch (const Error& e) {
         node["technique"].fail(e.what());
     }
@@ -471,7 +472,7 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
             if (!t.scenes.empty() &&
                 std::find(t.scenes.begin(), t.scenes.end(), scene.label) == t.scenes.end())
                 continue;
-            ParamSet base = TechniqueRegistry::instance().defaultParams(t.id);
+            ParamSet base = defaultRunParams(t.id);
             for (const auto& [k, v] : t.fixed)
                 base.setJson(k, v);
             ParamSet shared = defaultSharedParams();
@@ -526,10 +527,11 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
                     throw Error(config.path + ": technique \"" + t.id + "\" " +
                                 run.shared.toString() + ": " + e.what());
                 }
-                const TechniqueInfo& info = TechniqueRegistry::instance().get(t.id);
-                if (info.checkParams) {
+                const TechniqueInfo* info =
+                    t.id == kPathTracerId ? nullptr : &TechniqueRegistry::instance().get(t.id);
+                if (info && info->checkParams) {
                     try {
-                        info.checkParams(run.params);
+                        info->checkParams(run.params);
                     } catch (const Error& e) {
                         throw Error(config.path + ": technique \"" + t.id + "\" " +
                                     run.params.toString() + ": " + e.what());

@@ -50,6 +50,31 @@ const metrics::NoiseFloorSamples& ReferenceSet::noiseFloor(
     return it->second;
 }
 
+int ReferenceSet::maxBounces() const {
+    const auto& sidecar = m_result.sidecar;
+    if (sidecar.is_object() && sidecar.contains("settings") && sidecar["settings"].is_object() &&
+        sidecar["settings"].contains("max_bounces") &&
+        sidecar["settings"]["max_bounces"].is_number_integer())
+        return sidecar["settings"]["max_bounces"].get<int>();
+    return kAllBounces;
+}
+
+const std::optional<metrics::MetricSet>& ReferenceSet::bounceFloor(
+    int bounces, const metrics::MetricOptions& options) const {
+    const std::pair<int, bool> key{bounces, options.resampleFlip};
+    auto it = m_bounceFloors.find(key);
+    if (it != m_bounceFloors.end()) return it->second;
+    std::optional<metrics::MetricSet> floor;
+    const int max = maxBounces();
+    // match(b) for b >= max_bounces holds every bounce the path tracer traced: the full image
+    // (up to float rounding of the layer sums), so there is no floor below it to report.
+    if (bounces != kAllBounces && bounces < 3 && (max == kAllBounces || max > bounces)) {
+        const MatchedReference m = match(bounces);
+        floor = metrics::computeMetrics(m.final, m.full, options);
+    }
+    return m_bounceFloors.emplace(key, std::move(floor)).first->second;
+}
+
 MatchedReference ReferenceSet::match(int bounces) const {
     using ref::Layer;
     MatchedReference m;

@@ -11,7 +11,9 @@
  * standard error is used, which is exact).
  */
 #include <map>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "core/image/image.h"
@@ -47,6 +49,18 @@ public:
      */
     const metrics::NoiseFloorSamples& noiseFloor(const std::string& basis, const Image& image,
                                                  const metrics::MetricOptions& options) const;
+    /** The reference's max_bounces (its sidecar's settings; kAllBounces when not recorded). */
+    int maxBounces() const;
+    /**
+     * The bounce floor b (docs/experiments.md, "Bounce matching"): the exact b-bounce image
+     * match(b).final scored against the full reference, metrics::computeMetrics(match(b).final,
+     * full, options), computed on first use and reused by every run compared with this
+     * reference. nullopt when match(b) is the full image itself (maxBounces() <= b). `options`
+     * (tone map, ppd, referenceStdError = the full standard error, the "full" noise floor) are
+     * one experiment's, as for noiseFloor(); the key is b and options.resampleFlip.
+     */
+    const std::optional<metrics::MetricSet>& bounceFloor(
+        int bounces, const metrics::MetricOptions& options) const;
 
 private:
     const Image& mean(ref::Layer layer) const;
@@ -55,6 +69,7 @@ private:
     std::vector<ImageLayer> m_mean;
     std::vector<ImageLayer> m_stdError;
     mutable std::map<std::string, metrics::NoiseFloorSamples> m_noiseFloors;
+    mutable std::map<std::pair<int, bool>, std::optional<metrics::MetricSet>> m_bounceFloors;
 };
 
 }  // namespace gilab::exp

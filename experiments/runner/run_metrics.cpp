@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "core/technique/technique.h"
 #include "core/util/error.h"
 #include "experiments/metrics/direct_accuracy.h"
 #include "experiments/metrics/metrics.h"
@@ -127,6 +128,25 @@ nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers
         }
         entry["reference_mean"] = n > 0 ? sum / double(n) : 0.0;
         out[std::to_string(bounces)] = entry;
+    }
+    return out;
+}
+
+nlohmann::ordered_json computeBounceFloors(const ReferenceSet& references,
+                                           const MetricOptionsSpec& spec, const ToneMap& tonemap) {
+    // The options of "final_vs_full" in computeRunMetrics: the full standard error, resampled
+    // FLIP bars and the shared "full" noise floor (the same reference, so the same floor).
+    const MatchedReference full = references.match(kAllBounces);
+    metrics::MetricOptions options;
+    options.tonemap = tonemap;
+    options.ppd = spec.ppd;
+    options.referenceStdError = &full.fullStdError;
+    options.noiseFloor = &references.noiseFloor("full", full.full, options);
+    nlohmann::ordered_json out;
+    for (int bounces : {0, 1, 2}) {
+        const std::optional<metrics::MetricSet>& floor = references.bounceFloor(bounces, options);
+        out[std::to_string(bounces)] =
+            floor ? metrics::toJson(*floor) : nlohmann::ordered_json{{"same_as_full", true}};
     }
     return out;
 }

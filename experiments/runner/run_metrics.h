@@ -32,6 +32,19 @@ nlohmann::ordered_json computeBounceLadder(const std::vector<ImageLayer>& layers
                                            const MetricOptionsSpec& spec, const ToneMap& tonemap);
 
 /**
+ * The bounce floors of `references` (docs/experiments.md, "Bounce matching"): the path
+ * tracer's exact 0-, 1- and 2-bounce images (match(b).final) against the full reference, with
+ * the same options and resampled FLIP error bars as a run's "final_vs_full":
+ * {"0": M, "1": M, "2": M}; an entry whose b-bounce image is the full image itself (the
+ * reference's max_bounces <= b) is {"same_as_full": true} instead. Computed once per reference
+ * (ReferenceSet::bounceFloor) and written into every run's result. A technique claiming b
+ * bounces that scores better than floor b against the full reference makes up for the bounces
+ * it lacks with surplus energy.
+ */
+nlohmann::ordered_json computeBounceFloors(const ReferenceSet& references,
+                                           const MetricOptionsSpec& spec, const ToneMap& tonemap);
+
+/**
  * The light every technique shares: its emission + direct layers against the reference's
  * emission + direct (`directReference` = ReferenceSet::match(0)). metrics::toJson(MetricSet).
  */

@@ -115,7 +115,7 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
     // Named copies: a temporary's items() would dangle in a range-for (before C++23).
     const Json techniqueParams = at({"technique", "params"}), sharedParams = at({"shared_params"}),
                sweptKeys = at({"technique", "swept"}), ladder = at({"metrics", "final_vs_bounces"}),
-               regions = at({"metrics", "regions"});
+               regions = at({"metrics", "regions"}), floors = at({"metrics", "bounce_floors"});
     for (const auto& [k, v] : techniqueParams.items()) {
         row["param." + k] = v;
         params += (params.empty() ? "" : " ") + k + "=" +
@@ -147,6 +147,13 @@ nlohmann::ordered_json resultRow(const nlohmann::ordered_json& r) {
     row["energy_ratio"] = at({"metrics", "energy_ratio"});
     for (const auto& [n, m] : ladder.items())
         addMetricColumns(row, "bounces" + n, m);
+    // The bounce floors (the path tracer's b-bounce image against the full reference): the same
+    // columns as full.*, null with floor<b>.same_as_full when the b-bounce image is the full one.
+    for (const auto& [n, m] : floors.items()) {
+        const bool same = jsonAt(m, {"same_as_full"}) == Json(true);
+        row["floor" + n + ".same_as_full"] = same;
+        addMetricColumns(row, "floor" + n, same ? Json::object() : m);
+    }
     for (const auto& [name, region] : regions.items()) {
         const std::string prefix = "region." + name;
         row[prefix + ".pixels"] = jsonAt(region, {"pixels"});

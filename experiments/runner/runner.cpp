@@ -63,6 +63,17 @@ private:
     std::map<std::string, std::unique_ptr<Scene>> m_scenes;
 };
 
+/**
+ * The technique parameters of a run's key: all of them, except a parameter added after results
+ * existed while it has the value that reproduces the images from before it (`seed` = 0: the
+ * techniques' sampling patterns, docs/experiments.md), so finished runs keep their keys.
+ */
+nlohmann::ordered_json keyParams(const ParamSet& params) {
+    nlohmann::ordered_json p = params.toOrderedJson();
+    if (p.contains("seed") && p["seed"] == 0) p.erase("seed");
+    return p;
+}
+
 /** Everything that changes a static run's result. */
 nlohmann::ordered_json runIdentityStatic(const ExperimentConfig& config, const RunSpec& run,
                                          const Scene& scene) {
@@ -71,7 +82,7 @@ nlohmann::ordered_json runIdentityStatic(const ExperimentConfig& config, const R
             {"reference_key", ref::referenceKey(scene, config.reference.settings)},
             {"reference_stop", ref::stopCriteriaJson(config.reference.stop)},
             {"technique", run.techniqueId},
-            {"params", run.params.toOrderedJson()},
+            {"params", keyParams(run.params)},
             {"shared", run.shared.toOrderedJson()},
             {"warmup", config.timing.warmupFrames},
             {"frames", config.timing.timedFrames},
@@ -475,6 +486,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                                           c.config.metrics, tm, tmp);
     result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
     result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
+    result["metrics"]["bounce_floors"] = computeBounceFloors(refs, c.config.metrics, tm);
     if (!sameVpl.is_null()) result["metrics"]["same_vpl"] = sameVpl;
 
     writeExrWithMainImage((tmp / "output.exr").string(), layers, "final",

@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_scalar_block_layout : require
 // First-bounce VPLs from a reflective shadow map (core/vpl/rsm.h; Aranha et al. §III-A): VPL k of
-// n reads the RSM texel under the fixed 2D Hammersley point k (Eq. 1), the same every frame.
+// n reads the RSM texel under the fixed 2D Hammersley point k (Eq. 1), the same every frame,
+// toroidally shifted by the technique's seed (Cranley-Patterson rotation; 0 for seed 0).
 // Flux (docs/vpl.md): the power the light delivers to the texel's surface times its albedo,
 // times the texels each VPL stands for (W H / n, uniform sampling):
 //   directional  E * A_texel                (A_texel: the texel's area across the beam)
@@ -25,13 +26,14 @@ layout(push_constant, std430) uniform Push {
     uint count;     // n VPLs
     uint first;     // first VPL written
     uint perspective;
+    vec2 shift;     // Cranley-Patterson rotation of the Hammersley points (seed 0: none)
 } pc;
 
 void main() {
     uint k = gl_GlobalInvocationID.x;
     if (k >= pc.count) return;
     ivec2 size = imageSize(rsmPosition);
-    vec2 u = vplHammersley(k, pc.count);
+    vec2 u = vplHammersleyShifted(k, pc.count, pc.shift);
     ivec2 texel = min(ivec2(u * vec2(size)), size - 1);
     vec4 p = imageLoad(rsmPosition, texel);
     Vpl v;

@@ -28,6 +28,12 @@ vec2 vplHammersley(uint k, uint n) {
     return vec2(float(k) / float(n), float(bitfieldReverse(k)) * 2.3283064365386963e-10);
 }
 
+// The same point under a Cranley-Patterson rotation (a toroidal shift by `shift` in [0,1)^2, from
+// a technique's `seed`: core/vpl/vpl_math.h cranleyPattersonShift); shift 0 is the point itself.
+vec2 vplHammersleyShifted(uint k, uint n, vec2 shift) {
+    return fract(vplHammersley(k, n) + shift);
+}
+
 // Shirley-Chiu concentric map of [0,1)^2 onto the unit disk: uniform in area, stratification kept.
 vec2 vplConcentricDisk(vec2 u) {
     vec2 o = 2.0 * u - 1.0;

@@ -128,6 +128,7 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
     ctx.timeCpu("cluster_visibility", [&] {
         cvgi::VisibilityParams vp;
         vp.raysPerFace = s.raysPerFace;
+        vp.rotation = cvgi::seedRotation(s.seed);
         visibility = cvgi::faceVisibility(voxels, clusters, vp);
     });
 

@@ -28,6 +28,11 @@ std::vector<ParamSpec> cvgiParamSpecs() {
                  "3D Bresenham rays per voxel face for the cluster visibility (paper 128; 32 "
                  "and 64 evaluated)",
                  kRebuild),
+        intParam("seed", 0, 0, 1000000000, "",
+                 "ray pattern: every face's rays rotated about its normal by a hashed angle (a "
+                 "Cranley-Patterson shift of the Hammersley azimuths); 0 = the unrotated rays "
+                 "(the images from before the parameter)",
+                 kRebuild),
         intParam("shadow_map_size", 8192, 64, 16384, "texels",
                  "emitter distance shadow map side (authors' code 8192)", kRebuild),
         intParam("camera_map_size", 256, 16, 4096, "texels",
@@ -70,6 +75,7 @@ CvgiSettings cvgiSettingsFrom(const ParamSet& p) {
     s.clusterIterations = uint32_t(p.getInt("cluster_iterations"));
     s.clusterAngleDeg = float(p.getFloat("cluster_angle_deg"));
     s.raysPerFace = uint32_t(p.getInt("rays_per_face"));
+    s.seed = uint32_t(p.getInt("seed"));
     s.shadowMapSize = uint32_t(p.getInt("shadow_map_size"));
     s.cameraMapSize = uint32_t(p.getInt("camera_map_size"));
     s.litBiasVoxels = float(p.getFloat("lit_bias_voxels"));

@@ -18,6 +18,9 @@ struct CvgiSettings {
     uint32_t clusterIterations = 10;
     float clusterAngleDeg = 35.0f;
     uint32_t raysPerFace = 128;
+    // The ray pattern (docs/techniques/cvgi.md "seed"): every face's ray set rotated about its
+    // normal by cvgi::seedRotation(seed) turns; 0 = the unrotated rays, bit for bit.
+    uint32_t seed = 0;
     uint32_t shadowMapSize = 8192;  // emitter distance map (authors' code)
     uint32_t cameraMapSize = 256;   // "small" camera distance map (size not given)
     // Emitter update (§4.4): re-run when they change, no new set-up.

@@ -11,6 +11,7 @@
 #include <tbb/parallel_for.h>
 
 #include "core/util/error.h"
+#include "core/vpl/vpl_math.h"
 
 namespace gilab::cvgi {
 
@@ -413,8 +414,8 @@ double radicalInverse2(uint32_t i) {
 }
 
 /** Per face, the integer end offset round(dir * 2N) of each ray (notes 000 §8.4). */
-std::vector<glm::ivec3> rayDeltas(uint32_t rays, uint32_t n) {
-    const std::vector<glm::vec3> local = hemisphereDirections(rays);
+std::vector<glm::ivec3> rayDeltas(uint32_t rays, uint32_t n, double rotation) {
+    const std::vector<glm::vec3> local = hemisphereDirections(rays, rotation);
     std::vector<glm::ivec3> deltas(6 * size_t(rays));
     for (uint32_t f = 0; f < 6; ++f)
         for (uint32_t r = 0; r < rays; ++r)
@@ -585,7 +586,7 @@ ClusterSightings clusterSightings(const FaceVisibility& visibility, uint32_t clu
     return out;
 }
 
-std::vector<glm::vec3> hemisphereDirections(uint32_t rays) {
+std::vector<glm::vec3> hemisphereDirections(uint32_t rays, double rotation) {
     std::vector<glm::vec3> dirs(rays);
     for (uint32_t i = 0; i < rays; ++i) {
         // Uniform in solid angle, one ray at the centre of each of `rays` equal cos-theta
@@ -594,11 +595,19 @@ std::vector<glm::vec3> hemisphereDirections(uint32_t rays) {
         // biased it by (rays + 1) / rays: +3.1 % at 32 rays).
         const double cosTheta = 1.0 - (double(i) + 0.5) / double(rays);
         const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
-        const double phi = 2.0 * std::numbers::pi * radicalInverse2(i);
+        // The seed's rotation about +z: a Cranley-Patterson shift of the azimuth alone (x + 0
+        // is x, so rotation 0 is the unrotated set bit for bit).
+        double azimuth = radicalInverse2(i) + rotation;
+        if (azimuth >= 1.0) azimuth -= 1.0;
+        const double phi = 2.0 * std::numbers::pi * azimuth;
         dirs[i] =
             glm::vec3(glm::dvec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta));
     }
     return dirs;
+}
+
+double seedRotation(uint32_t seed) {
+    return double(vpl::cranleyPattersonShift(seed).x);
 }
 
 glm::vec3 toFaceFrame(const glm::vec3& local, uint32_t face) {
@@ -628,8 +637,10 @@ FaceVisibility faceVisibility(const CompactVoxels& voxels, const Clusters& clust
                     std::to_string(clusters.owner.size()) + " entries, expected " +
                     std::to_string(voxels.count()));
     const uint32_t rays = params.raysPerFace, count = voxels.count();
-    const std::vector<glm::ivec3> deltas = rayDeltas(rays, voxels.resolution);
-    const std::vector<glm::vec3> local = hemisphereDirections(rays);
+    if (!(params.rotation >= 0.0 && params.rotation < 1.0))
+        throw Error("cvgi faceVisibility: rotation must be in [0, 1) turns");
+    const std::vector<glm::ivec3> deltas = rayDeltas(rays, voxels.resolution, params.rotation);
+    const std::vector<glm::vec3> local = hemisphereDirections(rays, params.rotation);
     std::vector<glm::vec3> directions(6 * size_t(rays));
     std::vector<float> cosines(rays);
     for (uint32_t r = 0; r < rays; ++r) {

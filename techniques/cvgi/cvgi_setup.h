@@ -59,6 +59,9 @@ uint32_t paperInitialClusters(uint32_t resolution);
 
 struct VisibilityParams {
     uint32_t raysPerFace = 128;  // §4.3 default; 32 and 64 also evaluated in the paper
+    /** Rotation of every face's ray set about its face normal, in turns [0, 1): the
+     *  technique's `seed` (0 = none, the rays from before the parameter). */
+    double rotation = 0.0;
 };
 
 struct FaceVisibility {
@@ -103,10 +106,17 @@ ClusterSightings clusterSightings(const FaceVisibility& visibility, uint32_t clu
 
 /**
  * `rays` unit directions about +z, uniform in solid angle (Hammersley at stratum centres:
- * cos theta = 1 - (i + 1/2)/rays, phi = 2 pi radicalInverse2(i)); the cosines sum to exactly
- * rays / 2. Deterministic.
+ * cos theta = 1 - (i + 1/2)/rays, phi = 2 pi ((radicalInverse2(i) + rotation) mod 1)); the
+ * cosines sum to exactly rays / 2 whatever the rotation. `rotation` (turns in [0, 1)) is a
+ * Cranley-Patterson rotation (Cranley & Patterson 1976) of the azimuth coordinate alone, i.e. a
+ * rotation of the whole set about +z: the cos-theta strata, and so the cosine sum, stay exact.
+ * 0 gives the unrotated set bit for bit. Deterministic.
  */
-std::vector<glm::vec3> hemisphereDirections(uint32_t rays);
+std::vector<glm::vec3> hemisphereDirections(uint32_t rays, double rotation = 0.0);
+
+/** The rotation (turns in [0, 1)) of cvgi's `seed` parameter: 0 for seed 0, else the first
+ *  coordinate of vpl::cranleyPattersonShift(seed) (a hash of the seed). */
+double seedRotation(uint32_t seed);
 
 /** Rotates a direction about +z so that +z maps to the axis of `face` (order -x,+x,-y,+y,-z,+z). */
 glm::vec3 toFaceFrame(const glm::vec3& local, uint32_t face);

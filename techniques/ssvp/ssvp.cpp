@@ -15,6 +15,7 @@
 #include "core/vpl/paraboloid_maps.h"
 #include "core/vpl/rsm.h"
 #include "core/vpl/vpl.h"
+#include "core/vpl/vpl_math.h"
 #include "core/vpl/vpl_shading.h"
 #include "techniques/ssvp/ssvp_propagation.h"
 
@@ -177,7 +178,7 @@ void SsvpTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarg
     }
     {
         PassScope pass(ctx, cmd, "misc.vpl_sample");
-        g.rsm->recordVpls(cmd, g.vpls, 0, s.firstBounceVpls);
+        g.rsm->recordVpls(cmd, g.vpls, 0, s.firstBounceVpls, vpl::cranleyPattersonShift(s.seed));
     }
     {
         PassScope pass(ctx, cmd, "misc.kmeans");

@@ -74,7 +74,9 @@ void SsvpPropagation::setSettings(const SsvpSettings& s, float sceneDiagonal) {
     p.count = s.firstBounceVpls;
     p.clusterCount = s.clusters;
     p.metric = s.literalMetric ? 1u : 0u;
-    p.seed = s.kmeansSeed;
+    // `seed` moves the K-means start (which VPLs seed the clusters) with the VPL pattern; the
+    // golden-ratio step keeps nearby seeds' starts apart; seed 0 leaves kmeans_seed as it was.
+    p.seed = s.kmeansSeed + s.seed * 0x9E3779B9u;
     p.secondCount = s.secondCount();
     p.perCluster = std::max(s.perCluster(), 1u);
     p.paperWeights = s.paperWeights ? 1u : 0u;
@@ -89,7 +91,7 @@ void SsvpPropagation::setSettings(const SsvpSettings& s, float sceneDiagonal) {
     q = p;
     q.count = s.ownMapClusters() > 0 ? s.secondCount() : 0u;
     q.clusterCount = s.ownMapClusters();
-    q.seed = s.kmeansSeed + 7919u;
+    q.seed = p.seed + 7919u;
     q.secondCount = 0;
     q.vplBase = s.firstBounceVpls;
     q.clusterBase = s.clusters;

@@ -28,6 +28,11 @@ std::vector<ParamSpec> ssvpParamSpecs() {
                  "reflective shadow map side (not given; authors' code 2048)", kRebuild),
         intParam("kmeans_seed", 1, 0, 1000000000, "",
                  "seed of the first frame's random centroid VPLs", kRebuild),
+        intParam("seed", 0, 0, 1000000000, "",
+                 "sampling pattern: Cranley-Patterson shift of the first-bounce Hammersley VPLs "
+                 "(an offset hashed from the seed) and K-means seed kmeans_seed + seed x "
+                 "0x9E3779B9; 0 = the unshifted pattern (the images from before the parameter)",
+                 kRebuild),
         intParam("light", -1, -1, 1024, "",
                  "scene light index of the main light (-1 = the first spot or directional)",
                  kRebuild),
@@ -91,6 +96,7 @@ SsvpSettings ssvpSettingsFrom(const ParamSet& p) {
     s.paraboloidResolution = uint32_t(p.getInt("paraboloid_resolution"));
     s.rsmResolution = uint32_t(p.getInt("rsm_resolution"));
     s.kmeansSeed = uint32_t(p.getInt("kmeans_seed"));
+    s.seed = uint32_t(p.getInt("seed"));
     s.light = int(p.getInt("light"));
     s.bounces = int(p.getInt("bounces"));
     s.positionWeight = float(p.getFloat("kmeans_position_weight"));

@@ -28,6 +28,10 @@ struct SsvpSettings {
     uint32_t paraboloidResolution = 256;
     uint32_t rsmResolution = 512;
     uint32_t kmeansSeed = 1;
+    // The technique's sampling pattern (docs/techniques/ssvp.md "seed"): a Cranley-Patterson
+    // shift of the first-bounce Hammersley VPLs and another K-means start; 0 = the unseeded
+    // pattern, bit for bit.
+    uint32_t seed = 0;
     int light = -1;  // scene light index of the main light; -1 = the first spot or directional
     // Per frame.
     int bounces = 2;

@@ -15,6 +15,7 @@
 #include "core/vk/context.h"
 #include "core/vpl/rsm.h"
 #include "core/vpl/vpl.h"
+#include "core/vpl/vpl_math.h"
 #include "techniques/topovpl/gate_lighting.h"
 #include "techniques/topovpl/pixel_clusters.h"
 #include "techniques/topovpl/scene_topology.h"
@@ -269,7 +270,7 @@ void TopovplTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameT
     }
     {
         PassScope pass(ctx, cmd, "misc.vpl_sample");
-        g.rsm->recordVpls(cmd, g.vpls, 0, s.vpls);
+        g.rsm->recordVpls(cmd, g.vpls, 0, s.vpls, vpl::cranleyPattersonShift(s.seed));
     }
     {
         PassScope pass(ctx, cmd, "misc.vpl_clusters");

@@ -52,6 +52,11 @@ std::vector<ParamSpec> topovplParamSpecs() {
         intParam("vpls", 1024, 1, 65536, "",
                  "VPLs from the reflective shadow map (paper 512, 1024, 2048; 4192 Sibenik)",
                  kRebuild),
+        intParam("seed", 0, 0, 1000000000, "",
+                 "VPL pattern: Cranley-Patterson shift of the Hammersley points the VPLs read "
+                 "the RSM at (an offset hashed from the seed); 0 = the unshifted points (the "
+                 "images from before the parameter)",
+                 kRebuild),
         intParam("rsm_resolution", 512, 16, 4096, "texels",
                  "reflective shadow map side (the paper does not say how it makes VPLs)", kRebuild),
         intParam("light", -1, -1, 1024, "",
@@ -99,6 +104,7 @@ TopovplSettings topovplSettingsFrom(const ParamSet& p) {
     s.lifespanFilter = p.getEnum("skeleton_filter") == "lifespan";
     s.useCache = p.getEnum("topology_cache") == "on";
     s.vpls = uint32_t(p.getInt("vpls"));
+    s.seed = uint32_t(p.getInt("seed"));
     s.rsmResolution = uint32_t(p.getInt("rsm_resolution"));
     s.light = int(p.getInt("light"));
     s.listCapacityMiB = uint32_t(p.getInt("list_capacity_mib"));

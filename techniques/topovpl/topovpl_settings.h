@@ -27,6 +27,9 @@ struct TopovplSettings {
     bool lifespanFilter = true;       // the authors' thinning filter; false: our spur pruning
     bool useCache = true;
     uint32_t vpls = 1024;  // Table I: 512, 1024, 2048
+    // The VPL pattern (docs/techniques/topovpl.md "seed"): a Cranley-Patterson shift of the
+    // Hammersley points the VPLs read the RSM at; 0 = the unshifted points, bit for bit.
+    uint32_t seed = 0;
     uint32_t rsmResolution = 512;
     int light = -1;
     uint32_t listCapacityMiB = 64;

@@ -3,19 +3,14 @@
 synthetic renders with known per-sample noise, costs and bias. No Blender, no EXR files: a few
 seconds.
 
-    /usr/bin/python3 tests/crosscheck/test_analysis.py
+    PYTHONPATH=scripts /usr/bin/python3 tests/crosscheck/test_analysis.py
     (ctest: CpuCyclesCrosscheck.AnalysisOnSyntheticRenders)
 """
-import os
-import sys
 import unittest
 
 import numpy as np
 
-REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-sys.path.insert(0, os.path.join(REPO, "scripts"))
-
-import cycles_crosscheck as C  # noqa: E402
+import cycles_crosscheck as C  # scripts/ on PYTHONPATH (tests/CMakeLists.txt)
 
 H, W = 96, 128
 

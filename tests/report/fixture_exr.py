@@ -1,6 +1,6 @@
 """OpenEXR files for the report's tests, with numpy: a writer (the fixture's EXR outputs and
 references) and an independent reader (the expected linear values of the inspector's check).
-Neither shares code with scripts/report/report_exr.py, whose reader the test checks.
+Neither shares code with scripts/gilab_report/exr.py (OpenImageIO), whose reader the test checks.
 
 Single-part scanline files, compression NONE or ZIP (16 lines per chunk), channels FLOAT or
 HALF, as OpenEXR 2 defines them: the channel list sorted by name, each line holding every

@@ -3,7 +3,7 @@
 
     /usr/bin/python3 tests/report/make_fixture.py OUTDIR [--no-sweeps]
 
-Contents (schema 1, see scripts/report/report_data.py for what the report reads):
+Contents (schema 1, see scripts/gilab_report/data.py for what the report reads):
   scenes      "cornell_box" (64x64; two metric regions; error bars from the reference's noise)
               and "sponza#sun" (96x64; no regions, no error bars)
   techniques  "direct" (0 bounces, nothing swept), "tech_a" (1-D sweep of cone_count),
@@ -59,7 +59,6 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import fixture_exr  # noqa: E402
 
 SCENES = {"cornell_box": (64, 64), "sponza#sun": (96, 64)}

@@ -532,7 +532,7 @@ def check_rank_order(checks: Any, results_dir: str, dom: str, basis: str) -> Non
 def check_order(checks: Any, dom: str) -> None:
     """The cross-technique answer right after the header (and the invalid-run warning), before
     the images, and first in the navigation: the study section (two or more techniques on a
-    scene, report_study_html.py) when present, then the equal-time/error tables."""
+    scene, gilab_report/study_html.py) when present, then the equal-time/error tables."""
     body = dom.split("</nav>", 1)[-1]
     h2s = re.findall(r'<h2 id="([^"]+)"', body)
     nav = re.search(r"<nav>(.*?)</nav>", dom, re.S)

@@ -1,8 +1,8 @@
 #!/usr/bin/python3
-"""End-to-end test of scripts/report/make_report.py: synthetic results in, page checked in
+"""End-to-end test of the report (python3 -m gilab_report): synthetic results in, page checked in
 headless Chromium.
 
-    /usr/bin/python3 tests/report/test_report.py [--keep]
+    PYTHONPATH=scripts /usr/bin/python3 tests/report/test_report.py [--keep]
 
 Builds fixtures (tests/report/make_fixture.py) in a temporary folder, runs the report on them
 and checks the page: files it links exist, it loads with no console message and no uncaught
@@ -30,12 +30,11 @@ import urllib.parse
 from dataclasses import dataclass, field
 from typing import Optional
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import page_checks  # noqa: E402
+import page_checks
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
-REPORT = os.path.join(ROOT, "scripts", "report", "make_report.py")
+REPORT = ["-m", "gilab_report"]  # PYTHONPATH holds scripts/ (tests/CMakeLists.txt)
 FIXTURE = os.path.join(HERE, "make_fixture.py")
 PYTHON = "/usr/bin/python3"
 CHROMIUM = "/usr/bin/chromium"
@@ -138,7 +137,7 @@ def load_dom(checks: Checks, tmp: str, page: str, what: str, fragment: str = "")
 
 
 def make_report(dirs: list[str], out: Optional[str] = None) -> subprocess.CompletedProcess:
-    return run([PYTHON, REPORT, *dirs] + (["--out", out] if out else []), timeout=120.0)
+    return run([PYTHON, *REPORT, *dirs] + (["--out", out] if out else []), timeout=120.0)
 
 
 def make_fixture(out: str, sweeps: bool = True) -> None:
@@ -444,12 +443,10 @@ def copy_with_devices(source: str, out: str, two_devices: bool) -> None:
 def error_time_figures(results_dir: str) -> dict[str, tuple[object, int]]:
     """scene -> (the error-vs-time matplotlib Figure the report draws, built in this process,
     and its number of bases: a row of two panels each per device)."""
-    if os.path.dirname(REPORT) not in sys.path:
-        sys.path.insert(0, os.path.dirname(REPORT))
-    import make_report as report  # noqa: E402 (the report's own modules)
-    import report_figures
-    from report_analysis import by_scene, technique_colors
-    from report_data import load_results
+    from gilab_report import figures as report_figures  # the report's own modules
+    from gilab_report import make as report
+    from gilab_report.analysis import by_scene, technique_colors
+    from gilab_report.data import load_results
 
     runs = load_results([results_dir]).runs
     colors = technique_colors([r.technique for r in runs])

@@ -1,9 +1,9 @@
 #!/usr/bin/python3
-"""Tests of the cross-technique study analysis (scripts/report/report_study.py), its HTML and
-Markdown renderings (report_study_html.py) and scripts/findings.py, on synthetic rows with known
+"""Tests of the cross-technique study analysis (gilab_report/study.py), its HTML and
+Markdown renderings (gilab_report/study_html.py) and scripts/findings.py, on synthetic rows with known
 answers. No Chromium, no GPU: a few seconds.
 
-    /usr/bin/python3 tests/report/test_study.py        (ctest: CpuReportStudy.AnalysisAndFindings)
+    PYTHONPATH=scripts /usr/bin/python3 tests/report/test_study.py (ctest: CpuReportStudy.AnalysisAndFindings)
 """
 from __future__ import annotations
 
@@ -15,13 +15,12 @@ import tempfile
 import unittest
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-sys.path.insert(0, os.path.join(REPO, "scripts", "report"))
 
 import matplotlib  # noqa: E402
 
 matplotlib.use("agg")
-import report_study as S  # noqa: E402
-import report_study_html as H  # noqa: E402
+from gilab_report import study as S  # noqa: E402
+from gilab_report import study_html as H  # noqa: E402
 
 DEVICE = "llvmpipe (LLVM 15.0.6, 256 bits)"
 

@@ -1,11 +1,11 @@
 #!/usr/bin/python3
-"""Known-answer tests of the verdict rules (scripts/report/verdicts.py) and of their use by the
-study analysis (report_study.py), `gilab report`'s HTML and scripts/findings.py (issue 44):
+"""Known-answer tests of the verdict rules (scripts/gilab_report/verdicts.py) and of their use by the
+study analysis (gilab_report/study.py), `gilab report`'s HTML and scripts/findings.py (issue 44):
 a compensating run flagged and kept from the headline, a borderline budget marked, a seed spread
 widening a tie, the two-size cost split recovered, paper.json read for the paper rung, and the
 report and the findings agreeing on every verdict. No GPU, no Chromium: a few seconds.
 
-    /usr/bin/python3 tests/report/test_verdicts.py      (ctest: CpuReportStudy.VerdictRules)
+    PYTHONPATH=scripts /usr/bin/python3 tests/report/test_verdicts.py (ctest: CpuReportStudy.VerdictRules)
 """
 from __future__ import annotations
 
@@ -19,15 +19,14 @@ import unittest
 
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-sys.path.insert(0, os.path.join(REPO, "scripts", "report"))
-sys.path.insert(0, HERE)
 
 import matplotlib  # noqa: E402
 
 matplotlib.use("agg")
-import paper_facts as PF  # noqa: E402
-import report_study as S  # noqa: E402
-import verdicts as V  # noqa: E402
+from gilab_report import cost as C  # noqa: E402
+from gilab_report import paper_facts as PF  # noqa: E402
+from gilab_report import study as S  # noqa: E402
+from gilab_report import verdicts as V  # noqa: E402
 from test_study import result_json, row  # noqa: E402
 
 
@@ -147,6 +146,38 @@ class Cost(unittest.TestCase):
         self.assertAlmostEqual(split.at(1920 * 1080), 2.0 + 30.0 * 1920 * 1080 / 1e6)
         self.assertIsNone(V.cost_split((small, 1.0), (small, 2.0)))
 
+    def test_the_study_splits_a_rung_timed_at_two_sizes(self):
+        def t(px):
+            return 2.0 + 3e-5 * px
+        rows = []
+        for label, (w, h) in (("box", (64, 64)), ("box_2x", (128, 128))):
+            for tech, y in (("direct", 0.9), ("vct", 0.5)):
+                r = row(label, tech, t(w * h) * (1 if tech == "vct" else 0.5), y)
+                r["scene_source"], r["resolution"] = "scenes/box.json#spot", f"{w}x{h}"
+                rows.append(r)
+        study = S.analyse(rows, budgets=(50,))
+        self.assertEqual(study.size_twins, {"box_2x": "box"})
+        self.assertEqual(list(S.quality_scenes(study)), ["box"])  # the twin gives no verdict
+        self.assertEqual(S.verdict_table(study)["vct"][0].wins, ["box"])
+        vct = next(c for c in C.whole_cost(study) if c.series == "vct")
+        self.assertAlmostEqual(vct.split.fixed_ms, 2.0)
+        self.assertAlmostEqual(vct.split.per_mpixel_ms, 30.0)
+        self.assertEqual(vct.scenes, 1)
+        self.assertIn("box (64x64) vs box_2x (128x128)", vct.split_where)
+
+    def test_the_light_move_frame_and_payback(self):
+        r = row("orbit", "vct", 10.0, 0.5)
+        r.update({"animation_frames": 9, "animation_moves": "light", "setup_ms": 500.0,
+                  "dynamic_frame_gpu_ms_median": 60.0})
+        r2 = row("orbit", "ssvp", 20.0, 0.4)
+        r2.update({"animation_frames": 9, "animation_moves": "light", "setup_ms": 5.0,
+                   "dynamic_frame_gpu_ms_median": 20.0})
+        study = S.analyse([r, r2])
+        costs = {c.series: c for c in C.whole_cost(study)}
+        self.assertEqual(costs["vct"].light_ms, 60.0)
+        self.assertAlmostEqual(costs["vct"].payback_frames, 500.0 / 50.0)
+        self.assertIsNone(costs["ssvp"].payback_frames)  # the update costs nothing extra
+
     def test_payback(self):
         self.assertAlmostEqual(V.payback_frames(1000.0, 60.0, 10.0), 20.0)
         self.assertIsNone(V.payback_frames(1000.0, 10.0, 10.0))
@@ -220,8 +251,7 @@ class ReportAndFindingsAgree(unittest.TestCase):
             with open(out, encoding="utf-8") as f:
                 md_cells = _md_winners(f.read(), "box")
             report = os.path.join(tmp, "report")
-            p = subprocess.run([sys.executable,
-                                os.path.join(REPO, "scripts", "report", "make_report.py"),
+            p = subprocess.run([sys.executable, "-m", "gilab_report",
                                 results, "--out", report], capture_output=True, text=True,
                                timeout=300)
             self.assertEqual(p.returncode, 0, p.stderr)

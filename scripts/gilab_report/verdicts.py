@@ -1,6 +1,6 @@
 """The study's verdict rules, defined once: Pareto front, equal time, equal error, ties,
 borderline verdicts, compensation, pooled noise and the two-size cost split. `gilab report`
-(report_study.py, report_study_html.py) and scripts/findings.py both call these functions and
+(study.py, study_html.py) and findings.py both call these functions and
 nothing else decides a verdict. Pure functions of numbers; docs/report.md ("Verdict rules")
 states each rule in words, tests/report/test_verdicts.py checks each on known answers.
 

@@ -1,8 +1,8 @@
 """The report page: one self-contained HTML file (inline CSS/JS, images by relative path).
 
 Each section is one function returning an HTML string; a section that applies to no run
-returns "" and is left out of the page and its navigation. The tables are in report_tables.py,
-the shared helpers in report_common.py, the image inspector's data in report_inspect.py.
+returns "" and is left out of the page and its navigation. The tables are in tables.py,
+the shared helpers in common.py, the image inspector's data in inspector.py.
 """
 from __future__ import annotations
 
@@ -10,21 +10,22 @@ import os
 from dataclasses import dataclass
 from typing import Optional
 
-from report_analysis import (Sweep, best_key, best_runs, by_device, by_scene, param_value,
+from .analysis import (Sweep, best_key, best_runs, by_device, by_scene, param_value,
                              params_text, pareto_fronts, pareto_ties, slug)
-from report_assets import BODY_JS, CSS, HEAD_JS, INSPECTOR_JS, MAGMA_STOPS
-from report_animation import animation_anchor, animation_html
-from report_common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link,
+from .assets import BODY_JS, CSS, HEAD_JS, INSPECTOR_JS, MAGMA_STOPS
+from .animation import animation_anchor, animation_html
+from .common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link,
                            esc, fmt_fixed, fmt_flip, fmt_ms, fmt_sig, img_html, noisy_mark,
                            nonfinite_count, params_html, rel_url, scene_anchor, status_badge,
                            swatch, time_with_bar, update_badge, with_bar)
-from report_data import Run, dig, num, text
-from report_device import (DYNAMIC_FRAME, device_groups, device_label, device_names,
+from .data import Run, dig, num, text
+from .device import (DYNAMIC_FRAME, device_groups, device_label, device_names,
                            dynamic_clock, hosts_of, nodes_phrase, time_label)
-from report_inspect import BUDGET_CHARS, MAX_PIXELS, Layer
-from report_noise import (NOISY_IQR_FRACTION, change_words, noisy_run, noisy_time, tied_best,
+from .inspector import BUDGET_CHARS, MAX_PIXELS, Layer
+from .noise import (NOISY_IQR_FRACTION, change_words, noisy_run, noisy_time, tied_best,
                           time_change_words)
-from report_tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
+from .templates import Markup, render
+from .tables import (equal_html, experiment_name, failures_html, footer_html, header_html,
                            invalid_banner_html, run_table_html, skipped_html, unreadable_html)
 
 
@@ -95,7 +96,7 @@ def _exists(path: Optional[str]) -> bool:
 
 
 # What the report's own error map is, where the runner wrote no HDR-FLIP map against the full
-# reference (report_inspect.relerr_map).
+# reference (inspector.relerr_map).
 RELERR_WORDS = ("per pixel |Y(run) − Y(full reference)| / mean Y(full reference), Y the linear "
                 "luminance, in magma from 0 to 1 (1: an error as large as the reference's mean "
                 "luminance). It is not HDR-FLIP: the runner wrote no FLIP map against the full "
@@ -550,7 +551,7 @@ def _devices_caption(runs: list[Run]) -> str:
 
 def _front_tables(page: Page, scene: str, runs: list[Run]) -> str:
     """The Pareto tables under a scene's figure: one per comparable group, of each device apart
-    when the runs were timed on several (as the figure's columns; make_report.page_fronts)."""
+    when the runs were timed on several (as the figure's columns; make.page_fronts)."""
     basis = page.basis(scene)
     parts = []
     for device, members in by_device(runs).items():
@@ -739,9 +740,9 @@ def inspector_html(page: Page) -> str:
 
 
 def study_html(page: Page) -> str:
-    """The cross-technique study section (report_study_html), one block per device model;
+    """The cross-technique study section (study_html), one block per device model;
     '' when it does not apply."""
-    from report_study_html import series_colors, study_section_html
+    from .study_html import series_colors, study_section_html
 
     blocks = []
     for study in page.study:
@@ -763,7 +764,7 @@ def study_html(page: Page) -> str:
 
 def verdict_html(page: Page) -> str:
     """The first screen's verdict table of the first device model's study ('' without one)."""
-    from report_study_html import series_colors, verdict_screen_html
+    from .study_html import series_colors, verdict_screen_html
 
     for study in page.study[:1]:
         return verdict_screen_html(study, series_colors(study.series, page.colors))
@@ -781,11 +782,10 @@ def render_page(page: Page) -> str:
                 + ", ".join(f"<code>{esc(d)}</code>" for d in page.results.dirs)
                 + ". Run the experiment first (<code>gilab run CONFIG</code>); runs in progress "
                 "(folders starting with '.') are not shown.</div>") + unreadable_html(page)
-    nav = "".join(f'<a href="#{i}">{t}</a>' for i, t in NAV_TITLES if f'id="{i}"' in body
-                  or i == "definitions")
-    title = f"gilab report — {experiment_name(page.results)}"
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
-            f"<title>{esc(title)}</title><style>{CSS}</style><script>{HEAD_JS}</script></head>"
-            f"<body>{header_html(page, verdict_html(page))}<nav>{nav}</nav>{body}{footer_html(page)}"
-            f"{inspector_html(page)}<script>{BODY_JS}{INSPECTOR_JS}</script></body></html>\n")
+    nav = [(i, t) for i, t in NAV_TITLES if f'id="{i}"' in body or i == "definitions"]
+    header = header_html(page, verdict_html(page))
+    return render("page.html.j2", title=f"gilab report — {experiment_name(page.results)}",
+                  css=Markup(CSS), head_js=Markup(HEAD_JS), header=Markup(header), nav=nav,
+                  body=Markup(body), footer=Markup(footer_html(page)),
+                  inspector=Markup(inspector_html(page)), body_js=Markup(BODY_JS),
+                  inspector_js=Markup(INSPECTOR_JS))

@@ -1,7 +1,7 @@
 """The report's figures: matplotlib, SVG backend, text kept as text (small files).
 
 Every function draws one figure into one .svg file and returns nothing; colours come from the
-caller (report_analysis.technique_colors) so that a technique has one colour everywhere.
+caller (analysis.technique_colors) so that a technique has one colour everywhere.
 """
 from __future__ import annotations
 
@@ -17,13 +17,13 @@ from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Patch  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, MaxNLocator, NullFormatter  # noqa: E402
 
-from report_analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E402
+from .analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E402
                              by_technique, param_value, params_text, pareto_fronts, pareto_ties,
                              shade, sweep_x)
-from report_device import (DYNAMIC_FRAME, device_group, device_groups,  # noqa: E402
+from .device import (DYNAMIC_FRAME, device_group, device_groups,  # noqa: E402
                            device_label, dynamic_clock, nodes_phrase, time_label)
-from report_data import Run, Temporal, text  # noqa: E402
-from report_noise import NOISY_IQR_FRACTION, noisy_run, noisy_time  # noqa: E402
+from .data import Run, Temporal, text  # noqa: E402
+from .noise import NOISY_IQR_FRACTION, noisy_run, noisy_time  # noqa: E402
 
 STYLE = {
     "svg.fonttype": "none",

@@ -528,7 +528,7 @@ def parse_run(data: dict, folder: str, results_dir: str) -> Run:
     )
 
 
-def _read_json(path: str) -> tuple[Any, str]:
+def read_json(path: str) -> tuple[Any, str]:
     """(parsed JSON, '') or (None, why it failed)."""
     try:
         with open(path, "r", encoding="utf-8") as f:
@@ -541,7 +541,7 @@ def _read_json(path: str) -> tuple[Any, str]:
 
 def _read_run_folder(folder: str, results_dir: str) -> Run | Unreadable:
     path = os.path.join(folder, "result.json")
-    data, why = _read_json(path)
+    data, why = read_json(path)
     if data is None:
         return Unreadable(path, why)
     if not isinstance(data, dict):
@@ -569,7 +569,7 @@ def load_results(dirs: list[str]) -> Results:
     results = Results(dirs=[os.path.abspath(d) for d in dirs])
     by_key: dict[str, Run] = {}
     for results_dir in results.dirs:
-        experiment, _ = _read_json(os.path.join(results_dir, "experiment.json"))
+        experiment, _ = read_json(os.path.join(results_dir, "experiment.json"))
         if isinstance(experiment, dict):
             results.experiments.append(experiment)
         for folder in _run_folders(results_dir):

@@ -9,9 +9,9 @@ import re
 from dataclasses import dataclass
 from typing import Any, Callable, Optional
 
-from report_data import Animation, MetricView, Run, num, text
-from report_device import device_group, device_groups
-from report_noise import front_ties
+from .data import Animation, MetricView, Run, num, text
+from .device import device_group, device_groups
+from .noise import front_ties
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
 TECHNIQUE_PALETTE = ("#0072B2", "#D55E00", "#009E73", "#CC79A7", "#E69F00", "#56B4E9",
@@ -305,7 +305,7 @@ def pareto_ties(runs: list[Run], basis: Basis,
                 sigma: Optional[Callable[[Run], Optional[float]]] = None
                 ) -> dict[str, dict[int, Run]]:
     """Per comparable group: the runs off its front that are inseparable from a front run
-    (frame-time IQRs and error bars both overlap), id(run) -> that front run (report_noise)."""
+    (frame-time IQRs and error bars both overlap), id(run) -> that front run (noise)."""
     error = error or basis.flip
     sigma = sigma or basis.flip_sigma
     out = {}

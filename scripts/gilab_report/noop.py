@@ -14,8 +14,8 @@ import json
 import os
 from typing import Optional
 
-from report_analysis import Sweep
-from report_data import Run, dig
+from .analysis import Sweep
+from .data import Run, dig
 
 _HASHES: dict[str, Optional[str]] = {}
 

@@ -1,9 +1,9 @@
 """The image inspector's data (docs/report.md, "Image inspector").
 
-Clicking an image of the page opens it in the inspector (report_assets.INSPECTOR_JS): nearest-
+Clicking an image of the page opens it in the inspector (assets.INSPECTOR_JS): nearest-
 neighbour zoom, flipping between the layers of its group (the run, the references, the error
 maps, ...) and the linear values under the cursor. The values are read here from the runs' and
-references' EXR files (report_exr, standard library only) and embedded in the page, per image,
+references' EXR files (exr.py, OpenImageIO) and embedded in the page, per image,
 as base64 little-endian float16 RGB (float32 when a value is beyond float16's range), row-major,
 top row first, at the EXR's resolution (that of the PNG previews). Only images of at most
 MAX_PIXELS pixels are embedded, and at most BUDGET_CHARS characters of them in one page; the
@@ -26,7 +26,7 @@ import zlib
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from report_exr import ExrImage, ExrProblem, read_exr
+from .exr import ExrImage, ExrProblem, read_exr
 
 MAX_PIXELS = 256 * 256  # per embedded image
 BUDGET_CHARS = 8 * 1024 * 1024  # of base64 text per page

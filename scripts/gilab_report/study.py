@@ -1,6 +1,6 @@
 """Cross-technique analysis of a study (several techniques, each along its quality ladder, on the
 same scenes): series, Pareto fronts, equal-time and equal-error tables, the direct floor, and
-where each series breaks. Pure functions of the result rows; the report (report_study_html.py)
+where each series breaks. Pure functions of the result rows; the report (study_html.py)
 and scripts/findings.py render what this module computes. Every rule and threshold is defined
 here once and documented in docs/report.md ("Cross-technique study").
 
@@ -20,9 +20,9 @@ import statistics
 from dataclasses import dataclass, field
 from typing import Any, Iterable, Optional
 
-import paper_facts as PF
-import verdicts as V
-from report_data import dig
+from . import paper_facts as PF
+from . import verdicts as V
+from .data import dig
 
 # ------------------------------------------------------------------------------------------------
 # Rules and thresholds (docs/report.md, "Cross-technique study")
@@ -177,6 +177,10 @@ def row_from_result(data: dict) -> dict:
         "frame_cpu_ms_iqr": dig(d, "timing", "frame_cpu_ms", "iqr"),
         "reference_samples": dig(d, "reference", "samples"),
         "resolution": "x".join(str(v) for v in dig(d, "scene", "resolution") or []) or None,
+        "scene_source": (f"{dig(d, 'scene', 'path') or ''}#{dig(d, 'scene', 'variant') or ''}"
+                         if dig(d, "scene", "path") is not None else None),
+        "animation_moves": " ".join(m for m in dig(d, "animation", "moves") or []
+                                    if isinstance(m, str)) or None,
         "memory_total_bytes": dig(d, "memory", "total_bytes"),
         "reference_matched": dig(d, "reference", "matched"),
         "energy_ratio": dig(d, "metrics", "energy_ratio"),
@@ -218,7 +222,7 @@ def row_from_result(data: dict) -> dict:
 
 
 def rows_from_runs(runs: Iterable[Any]) -> list[dict]:
-    """Rows of report_data Run records (their result.json in run.data)."""
+    """Rows of data.py Run records (their result.json in run.data)."""
     out = []
     for run in runs:
         row = row_from_result(getattr(run, "data", {}) or {})
@@ -235,7 +239,7 @@ def _luminance_sum(path: Optional[str], layer: str) -> Optional[float]:
     """Σ Rec. 709 luminance of an EXR's '<layer>.R/G/B' (layer '' : R, G, B), finite pixels."""
     if not path or not os.path.isfile(path):
         return None
-    from report_exr import ExrImage, read_exr
+    from .exr import ExrImage, read_exr
 
     prefix = f"{layer}." if layer else ""
     image = read_exr(path, LEAK_MAX_PIXELS, {prefix + c for c in "RGB"})
@@ -275,10 +279,10 @@ def add_leak_shares(rows: list[dict], runs: Iterable[Any]) -> None:
 
 
 def load_rows(dirs: list[str], unreadable: Optional[list[str]] = None) -> list[dict]:
-    """Every committed run of the folders (report_data's reader: shards merged, in-progress
+    """Every committed run of the folders (data.py's reader: shards merged, in-progress
     folders ignored) as rows; an unreadable run folder is left out and, given `unreadable`,
     added to it as 'path: why'."""
-    from report_data import load_results
+    from .data import load_results
 
     results = load_results(dirs)
     if unreadable is not None:
@@ -885,17 +889,59 @@ class Study:
     commits: list[str]
     time_spread: dict[str, float] = field(default_factory=dict)  # technique -> pooled, relative
     seed_spread: dict[str, float] = field(default_factory=dict)  # technique -> pooled HDR-FLIP
+    # A scene rendered again at a larger image size (same scene file, variant and camera):
+    # larger scene -> the scene it repeats. It gives the cost split, not a verdict.
+    size_twins: dict[str, str] = field(default_factory=dict)
 
     def scene_best(self, scene: str, series: str) -> Optional[Point]:
         return self.scenes[scene].best(series)
 
 
+PATH_TRACER = "pathtracer"  # the equal-time path-tracer baseline (experiments/runner/pt_baseline.h)
+
+
 def by_device(rows: list[dict]) -> dict[str, list[dict]]:
-    """Rows by device model (device_name): times of two models are never compared."""
+    """Rows by device model (device_name): times of two models are never compared. The
+    path-tracer baseline runs on the host's CPU, so its rows join every device group of the
+    same host (the CPU that also runs lavapipe there); alone, they form their own group."""
     out: dict[str, list[dict]] = {}
+    baseline = [r for r in rows if fstr(r.get("technique")) == PATH_TRACER]
     for r in rows:
-        out.setdefault(device_name([r]), []).append(r)
+        if fstr(r.get("technique")) != PATH_TRACER:
+            out.setdefault(device_name([r]), []).append(r)
+    for r in baseline:
+        groups = [g for g in out.values() if any(fstr(x.get("host")) == fstr(r.get("host"))
+                                                 for x in g)]
+        for g in groups or [out.setdefault(device_name([r]), [])]:
+            g.append(r)
     return dict(sorted(out.items(), key=lambda kv: -len(kv[1])))
+
+
+def _pixels(resolution: Any) -> Optional[int]:
+    try:
+        w, h = (int(v) for v in fstr(resolution).split("x"))
+        return w * h
+    except ValueError:
+        return None
+
+
+def size_twins(rows: list[dict]) -> dict[str, str]:
+    """Scenes that repeat another at a larger image size (the same scene_source): larger ->
+    the smallest one of its source."""
+    by_source: dict[str, dict[str, int]] = {}
+    for r in rows:
+        src, px = fstr(r.get("scene_source")), _pixels(r.get("resolution"))
+        if src and px:
+            by_source.setdefault(src, {})[fstr(r.get("scene"))] = px
+    out = {}
+    for scenes in by_source.values():
+        if len(set(scenes.values())) < 2:
+            continue
+        primary = min(scenes, key=lambda sc: (scenes[sc], sc))
+        for sc, px in scenes.items():
+            if px > scenes[primary]:
+                out[sc] = primary
+    return out
 
 
 def is_study(rows: list[dict]) -> bool:
@@ -927,7 +973,7 @@ def analyse(rows: list[dict], budgets: Iterable[float] = BUDGETS_MS,
                   device=device_name(rows), machine=machine_label(rows), rows=rows,
                   statuses=statuses,
                   commits=sorted({fstr(r.get("git_commit")) for r in rows} - {""}),
-                  time_spread=spreads[0], seed_spread=spreads[1])
+                  time_spread=spreads[0], seed_spread=spreads[1], size_twins=size_twins(rows))
     study.breaks = breaks(study, audit or {})
     return study
 
@@ -959,7 +1005,7 @@ def findings(study: Study) -> list[str]:
     """Plain sentences, each a restatement of numbers in the tables."""
     out = []
     for scene, st in study.scenes.items():
-        if scene in NOT_QUALITY:
+        if not is_quality(study, scene):
             continue
         absent = [s for s in study.series if not any(p.ranked for p in st.series.get(s, []))]
         if absent:
@@ -990,7 +1036,7 @@ def findings(study: Study) -> list[str]:
                                + ".")
     for s in study.series:
         rows = [(sc, st.best(s), [p for p in st.series.get(s, []) if p.ranked and p.paper])
-                for sc, st in study.scenes.items() if sc not in NOT_QUALITY]
+                for sc, st in study.scenes.items() if is_quality(study, sc)]
         parts = []
         for sc, best, papers in rows:
             if best is None or not papers:
@@ -1018,7 +1064,7 @@ def glance(study: Study) -> list[dict]:
     what broke (a flag of only some of its series names them)."""
     out = []
     by_series = {b.series: b for b in study.breaks}
-    quality = {sc: st for sc, st in study.scenes.items() if sc not in NOT_QUALITY}
+    quality = quality_scenes(study)
     techniques = list(dict.fromkeys(s.partition(" (")[0] for s in study.series))
     for tech in techniques:
         series = [s for s in study.series if s.partition(" (")[0] == tech]
@@ -1081,8 +1127,14 @@ class VerdictCell:
         return ", ".join(parts) or "—"
 
 
+def is_quality(study: Study, scene: str) -> bool:
+    """A scene whose errors give verdicts: not a failure test (NOT_QUALITY) and not a larger
+    size of another scene (its runs give the cost split)."""
+    return scene not in NOT_QUALITY and scene not in study.size_twins
+
+
 def quality_scenes(study: Study) -> dict[str, SceneStudy]:
-    return {sc: st for sc, st in study.scenes.items() if sc not in NOT_QUALITY}
+    return {sc: st for sc, st in study.scenes.items() if is_quality(study, sc)}
 
 
 def verdict_table(study: Study) -> dict[str, list[VerdictCell]]:

@@ -1,7 +1,6 @@
-#!/usr/bin/python3
 """Builds the HTML report of one gilab experiment (or of several shard folders, merged).
 
-    /usr/bin/python3 scripts/report/make_report.py DIR [DIR ...] [--out OUTDIR]
+    PYTHONPATH=scripts /usr/bin/python3 -m gilab_report DIR [DIR ...] [--out OUTDIR]
 
 Reads DIR/runs/<key>/result.json (run folders starting with '.' are in progress and ignored),
 writes OUTDIR/report.html (self-contained: inline CSS/JS and the inspector's linear values,
@@ -21,20 +20,18 @@ import platform
 import sys
 from typing import Optional
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-
-import report_figures  # noqa: E402
-import report_study  # noqa: E402
-from report_study_html import series_colors, study_figure  # noqa: E402
-from report_analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,  # noqa: E402
+from . import figures as report_figures
+from . import study as report_study
+from .study_html import series_colors, study_figure
+from .analysis import (FULL, MATCHED, ONE_BOUNCE, Basis, best_run,
                              best_runs, by_device, by_scene, find_sweeps, has_one_bounce,
                              pareto_fronts, pareto_ties, pass_colors, scene_basis, slug,
                              sweep_names, technique_colors)
-from report_noop import no_effect  # noqa: E402
-from report_data import Results, Run, load_results  # noqa: E402
-from report_common import Figures, Page  # noqa: E402
-from report_html import render_page  # noqa: E402
-from report_inspect import Inspector, clear_old_maps  # noqa: E402
+from .noop import no_effect
+from .data import Results, Run, load_results
+from .common import Figures, Page
+from .page import render_page
+from .inspector import Inspector, clear_old_maps
 
 REPO_DOCS = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..",
                                           "docs"))
@@ -134,7 +131,7 @@ def audit_path(dirs: list[str]) -> Optional[str]:
 
 
 def make_study(results: Results, dirs: list[str]) -> list[report_study.Study]:
-    """The cross-technique study (report_study.py) of each device model's runs on which two or
+    """The cross-technique study (study.py) of each device model's runs on which two or
     more techniques were measured on one scene (times of two models are never compared)."""
     runs = results.runs
     rows = report_study.rows_from_runs(runs)
@@ -230,7 +227,3 @@ def main(argv: list[str]) -> int:
     path = build_report(args.dirs, args.out or args.dirs[0])
     print(path)
     return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -8,10 +8,10 @@ import urllib.parse
 from dataclasses import dataclass, field
 from typing import Callable, Optional
 
-from report_analysis import MATCHED, Basis, Sweep, ordered_unique, param_value, slug
-from report_data import Results, Run, dig, num, text
-from report_inspect import Inspector
-from report_noise import NOISY_IQR_FRACTION, noisy_time
+from .analysis import MATCHED, Basis, Sweep, ordered_unique, param_value, slug
+from .data import Results, Run, dig, num, text
+from .inspector import Inspector
+from .noise import NOISY_IQR_FRACTION, noisy_time
 
 DASH = "—"
 CARD_IMAGE_WIDTH = 128  # CSS px of each image in the scene cards (five side by side)
@@ -46,7 +46,7 @@ class Page:
     docs_dir: Optional[str]
     generated: str
     tool_versions: str
-    inspector: Optional[Inspector] = None  # the image inspector's data (report_inspect)
+    inspector: Optional[Inspector] = None  # the image inspector's data (inspector)
     study: list = field(default_factory=list)  # report_study.Study per device model (2+
     # techniques measured on a scene; empty otherwise)
 
@@ -96,7 +96,7 @@ def img_html(path: Optional[str], page: Page, alt: str, width: int, css: str = "
              lazy: bool = False, inspect: Optional[tuple[str, int]] = None) -> str:
     """An <img> of a PNG shown `width` CSS px wide (linked to the full-size file), or a
     placeholder naming the missing file. inspect: (group id, layer index) of the image in the
-    inspector, which a click opens (report_inspect)."""
+    inspector, which a click opens (inspector)."""
     if not path or not os.path.isfile(path):
         where = os.path.relpath(path, page.out_dir) if path else "no file recorded"
         return f'<div class="missing">{esc(alt)}: image missing<br>{esc(where)}</div>'

@@ -8,17 +8,18 @@ import os
 from dataclasses import dataclass
 from typing import Callable, Optional
 
-from report_analysis import (MIN_COMPARED, best_within_budget, by_device, by_scene,
+from .analysis import (MIN_COMPARED, best_within_budget, by_device, by_scene,
                              by_technique, cheapest_reaching, comparable_groups, error_targets,
                              ordered_unique, params_text, slug, time_budgets)
-from report_common import (DASH, MIB, Page, doc_link, esc, first_message_html,
+from .common import (DASH, MIB, Page, doc_link, esc, first_message_html,
                            fmt_fixed, fmt_flip, fmt_ms, fmt_sig, noisy_mark, nonfinite_count,
                            params_html, rel_url, status_badge, swatch, time_with_bar,
                            update_badge, validation_summary, with_bar)
-from report_data import Results, Run, dig, num, text
-from report_device import (device_group, device_groups, device_names, device_note_html,
+from .data import Results, Run, dig, num, text
+from .device import (device_group, device_groups, device_names, device_note_html,
                            time_label)
-from report_noise import NOISY_IQR_FRACTION, error_separable, noisy_time, time_separable
+from .noise import NOISY_IQR_FRACTION, error_separable, noisy_time, time_separable
+from .templates import Markup, render
 
 
 # ---------------------------------------------------------------------------------------------
@@ -88,10 +89,8 @@ def header_html(page: Page, verdict: str = "") -> str:
         rows.append(("noisy timings", noisy))
     rows.append(("results", "<br>".join(esc(d) for d in res.dirs)))
     rows.append(("runs", counts_html(page)))
-    meta = "".join(f"<tr><td>{k}</td><td>{v}</td></tr>" for k, v in rows)
-    desc = "".join(f'<p class="lead">{esc(d)}</p>' for d in descriptions)
-    return (f"<header><h1>gilab report — {esc(experiment_name(res))}</h1>{desc}{verdict}"
-            f'<table class="meta">{meta}</table></header>')
+    return render("header.html.j2", name=experiment_name(res), descriptions=descriptions,
+                  verdict=Markup(verdict), rows=[(k, Markup(v)) for k, v in rows])
 
 
 def noisy_timings(runs: list[Run]) -> list[tuple[Run, str, float, float]]:
@@ -749,7 +748,7 @@ def footer_html(page: Page) -> str:
          "ms covering the observed times). Equal error: for each target E, the shortest median "
          "frame time among its runs with mean HDR-FLIP ≤ E (targets: the 90/75/50/25/10 % "
          "quantiles of the observed values)."),
-        ("Report", f"generated {esc(page.generated)} by <code>scripts/report/make_report.py"
+        ("Report", f"generated {esc(page.generated)} by <code>python3 -m gilab_report"
          f"</code> ({esc(page.tool_versions)}); described in " + doc_link(page, "report.md")
          + "."),
     ]

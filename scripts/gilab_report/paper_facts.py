@@ -16,7 +16,8 @@ from functools import lru_cache
 from typing import Optional
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-# Source tree (scripts/report -> techniques) and install tree (share/gilab/report -> ../techniques)
+# Source tree (scripts/gilab_report -> techniques) and install tree
+# (share/gilab/gilab_report -> share/gilab/techniques)
 SEARCH = (os.path.join(HERE, "..", "..", "techniques"), os.path.join(HERE, "..", "techniques"))
 KINDS = ("design", "erratum")
 

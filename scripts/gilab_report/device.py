@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import Optional
 
-from report_data import Run
+from .data import Run
 
 LAVAPIPE = "lavapipe (CPU)"
 LAVAPIPE_DRIVERS = ("", "llvmpipe", "lavapipe")

@@ -9,12 +9,12 @@ from __future__ import annotations
 
 from typing import Optional
 
-from report_analysis import by_scene, by_technique, best_key, ordered_unique, slug
-from report_common import (DASH, Page, doc_link, esc, fmt_fixed, fmt_flip, fmt_ms, img_html,
+from .analysis import by_scene, by_technique, best_key, ordered_unique, slug
+from .common import (DASH, Page, doc_link, esc, fmt_fixed, fmt_flip, fmt_ms, img_html,
                            noisy_mark, params_html, rel_url, swatch, time_with_bar,
                            update_badge)
-from report_data import Run, Temporal, TimeSummary
-from report_device import DYNAMIC_FRAME, device_label, device_names, time_label
+from .data import Run, Temporal, TimeSummary
+from .device import DYNAMIC_FRAME, device_label, device_names, time_label
 
 STRIP_IMAGE_WIDTH = 72  # CSS px of each thumbnail of the frame strip
 

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from typing import Callable, Optional
 
-import verdicts as V
-from report_data import Run
+from . import verdicts as V
+from .data import Run
 
 Metric = Callable[[Run], Optional[float]]
 

@@ -1,7 +1,7 @@
-"""Renderings of the cross-technique study (report_study.py): the error-against-time figure
+"""Renderings of the cross-technique study (study.py): the error-against-time figure
 (SVG for the report, PNG for scripts/findings.py: one drawing function), the report's HTML
 section, and the Markdown tables of docs/findings.md. Nothing is computed here that
-report_study does not define.
+study.py does not define.
 """
 from __future__ import annotations
 
@@ -17,8 +17,10 @@ if "matplotlib.pyplot" not in sys.modules:  # the caller's backend otherwise (sv
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
-import report_study as S  # noqa: E402
-from report_analysis import shade, technique_colors  # noqa: E402
+from . import cost as C  # noqa: E402
+from . import study as S  # noqa: E402
+from .analysis import shade, technique_colors  # noqa: E402
+from .templates import Markup, render  # noqa: E402
 
 FRONT_COLOR = "#111111"
 STUDY_GID = "study-front-"  # + run key: the ring of a Pareto-front point (SVG id)
@@ -287,6 +289,7 @@ def study_section_html(study: "S.Study", colors: dict[str, str],
         parts.append(_table(st.equal_error, series, colors, caption, "series",
                             lambda p: f"{S.ms(p.x)} <small>({S.sig3(p.y)})</small>")
                      or "<p>No direct floor on this scene: no targets.</p>")
+    parts.append(cost_table_html(study, colors, device_label))
     parts.append("<h3>Where it breaks</h3>")
     parts.append(breaks_table(study, colors, caption, device_label))
     return "".join(parts)
@@ -400,35 +403,21 @@ def verdict_screen_html(study: "S.Study", colors: dict[str, str]) -> str:
     reach = S.ladder_reach(study)
     if not any(c.wins for cells in table.values() for c in cells):
         return ""
-    heads = "".join(f"<th>≤ {b:g} ms</th>" for b in study.budgets)
     rows = []
     for s in study.series:
-        cells = "".join(
-            f'<td class="{"best" if c.wins else ("tie" if c.ties else "")}'
-            f'{" comp" if c.compensating and not c.wins else ""}" title="'
-            + _e("; ".join(x for x in (
-                f"wins: {', '.join(c.wins)}" if c.wins else "",
-                f"ties: {', '.join(c.ties)}" if c.ties else "",
-                f"borderline: {', '.join(c.borderline)}" if c.borderline else "",
-                f"compensating: {', '.join(c.compensating)}" if c.compensating else "") if x))
-            + f'">{_e(c.text())}</td>' for c in table[s])
-        rows.append(f"<tr><td>{_sw(s, colors)}</td>{cells}<td>{_e(_reach_words(reach.get(s)))}"
-                    f"</td><td>{_e(_noise_words(study, s))}</td></tr>")
-    lines = "".join(f"<li>{_e(line)}</li>" for line in S.scene_lines(study))
-    scenes = len(S.quality_scenes(study))
-    return ('<section id="verdict" class="verdict"><h2>Verdict: lowest HDR-FLIP against the full '
-            "reference within each frame-time budget</h2>"
-            f'<table class="data study verdict"><caption class="device-line">over {scenes} '
-            f"scenes; timed on {_e(study.device)}; {_e(S.DEVICE_CAVEAT)}</caption><thead><tr>"
-            f"<th>series</th>{heads}<th>ladder reach</th><th>noise in the rules</th></tr>"
-            f"</thead><tbody>{''.join(rows)}</tbody></table>"
-            '<p class="note">wins / ties: scenes where the series is the best or tied with it '
-            "within the noise (reference error bars, seed spread, time spread); borderline: "
-            "the verdict could change within the timing or error noise; compensating: the "
-            "series would win, but its full-basis error is below the floor of the bounces it "
-            "claims or flips against a rival on the bounce-matched basis, so it is not ranked "
-            "(docs/report.md, \"Verdict rules\").</p>"
-            f'<ul class="scene-verdicts">{lines}</ul></section>')
+        cells = [(("best" if c.wins else ("tie" if c.ties else ""))
+                  + (" comp" if c.compensating and not c.wins else ""),
+                  "; ".join(x for x in (
+                      f"wins: {', '.join(c.wins)}" if c.wins else "",
+                      f"ties: {', '.join(c.ties)}" if c.ties else "",
+                      f"borderline: {', '.join(c.borderline)}" if c.borderline else "",
+                      f"compensating: {', '.join(c.compensating)}" if c.compensating else "")
+                           if x), c.text()) for c in table[s]]
+        rows.append((Markup(_sw(s, colors)), cells, _reach_words(reach.get(s)),
+                     _noise_words(study, s)))
+    return render("verdict.html.j2", scenes=len(S.quality_scenes(study)), device=study.device,
+                  caveat=S.DEVICE_CAVEAT, budgets=[f"{b:g}" for b in study.budgets], rows=rows,
+                  lines=S.scene_lines(study))
 
 
 def md_verdict(study: "S.Study") -> list[str]:
@@ -447,4 +436,73 @@ def md_verdict(study: "S.Study") -> list[str]:
                    + f" | {_reach_words(reach.get(s))} | {_noise_words(study, s)} |")
     out += ["", "Per scene (time-free verdicts first: equal error, then equal time):", ""]
     out += [f"- {line}" for line in S.scene_lines(study)]
+    return out + [""]
+
+
+# ------------------------------------------------------------------------------------------------
+# Whole cost (cost.py)
+# ------------------------------------------------------------------------------------------------
+TIMED_COST_COLUMNS = ("static frame", "set-up cold", "set-up cached", "light moves",
+                      "camera moves", "fixed", "per Mpixel", "at 1920x1080")
+
+
+def cost_head(device: str) -> list[str]:
+    """The whole-cost table's headers; every time column names the device ('…, lavapipe
+    (CPU), ms')."""
+    timed = {c: f"{c}, {device}, ms" for c in TIMED_COST_COLUMNS}
+    return ["series", "rung", "scenes", timed["static frame"], "memory, MiB",
+            timed["set-up cold"], timed["set-up cached"], timed["light moves"],
+            timed["camera moves"], "payback, frames", timed["fixed"], timed["per Mpixel"],
+            timed["at 1920x1080"]]
+
+
+def cost_cells(c: "C.CostRow") -> list[str]:
+    def t(x: Optional[float]) -> str:
+        return S.sig3(x)
+    return [c.series, c.rung or "defaults", str(c.scenes) if c.scenes else "—", t(c.static_ms),
+            S.sig3(c.memory_mib), t(c.setup_ms), t(c.setup_cached_ms), t(c.light_ms),
+            t(c.camera_ms), S.sig3(c.payback_frames),
+            S.sig3(c.split.fixed_ms) if c.split else "—",
+            S.sig3(c.split.per_mpixel_ms) if c.split else "—", t(c.full_hd_ms)]
+
+
+COST_NOTE = ("static frame: median over the quality scenes; light / camera moves: the dynamic "
+             "frame (update included) of an animated scene whose light / camera moves; payback: "
+             "set-up / (light-move frame − static frame), the frames a precomputation must stay "
+             "valid to cost less than redoing the update each frame; fixed and per-pixel parts "
+             "from the rung timed at two image sizes (t = fixed + per-pixel × pixels), "
+             "extrapolated to 1920 × 1080 (a negative fixed part is noise or a cost that grows "
+             "faster than the pixel count)")
+
+
+def cost_table_html(study: "S.Study", colors: dict[str, str], device: str) -> str:
+    rows = C.whole_cost(study)
+    if not rows:
+        return ""
+    body = "".join("<tr>" + "".join(
+        f"<td>{_sw(v, colors) if i == 0 else _e(v)}</td>" for i, v in enumerate(cost_cells(c)))
+        + "</tr>" for c in rows)
+    head = "".join(f"<th>{_e(h)}</th>" for h in cost_head(device))
+    return (f'<h3 id="whole-cost">Whole cost</h3><table class="data study cost"><caption '
+            f'class="device-line">timed on {_e(study.device)}; machine {_e(study.machine)}'
+            f"</caption><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+            f'<p class="note">{_e(COST_NOTE)}</p>')
+
+
+def _short_device(device: str) -> str:
+    return "lavapipe (CPU)" if "lavapipe" in device else device
+
+
+def md_cost(study: "S.Study") -> list[str]:
+    rows = C.whole_cost(study)
+    if not rows:
+        return []
+    out = ["## Whole cost", "", f"Timed on {study.device}, {study.machine}. {COST_NOTE}.", "",
+           "| " + " | ".join(cost_head(_short_device(study.device))) + " |",
+           "|" + "---|" * len(cost_head(""))]
+    out += ["| " + " | ".join(cost_cells(c)) + " |" for c in rows]
+    splits = [f"{c.series} {c.rung}: {c.split_where}".replace("  ", " ") for c in rows
+              if c.split]
+    if splits:
+        out += ["", "Two-size pairs: " + "; ".join(splits) + "."]
     return out + [""]

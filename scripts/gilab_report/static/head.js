@@ -1,0 +1,5 @@
+
+function gilabImageError(img) {
+  img.classList.add("broken");
+  console.error("gilab report: cannot load image " + img.getAttribute("src"));
+}
