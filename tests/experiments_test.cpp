@@ -83,6 +83,34 @@ TEST(CpuExperimentConfig, ExpandsGridTimesZipTimesScenes) {
         EXPECT_EQ(runs[i].index, i);
 }
 
+// "repeats": the first round keeps the order (and keys) of a config without it; repeat r of
+// every configuration comes in round r, after every other run of round r - 1, so repeats are
+// interleaved with the other techniques' runs (issue 44). "frames" overrides timing.frames.
+TEST(CpuExperimentConfig, RepeatsComeInInterleavedRoundsAfterTheFirst) {
+    nlohmann::json j = baseConfig();
+    j["scenes"] = {"builtin"};
+    j["techniques"] = {{{"technique", "direct"}, {"repeats", 3}, {"frames", 25}},
+                       {{"technique", "pathtracer"}, {"sweep", {{"grid", {{"spp", {1, 4}}}}}}}};
+    const std::vector<RunSpec> runs = expandRuns(parseExperimentConfig(j, "cfg.json", "."));
+    ASSERT_EQ(runs.size(), 5u);
+    const std::vector<std::pair<std::string, int>> order{
+        {"direct", 0}, {"pathtracer", 0}, {"pathtracer", 0}, {"direct", 1}, {"direct", 2}};
+    for (size_t i = 0; i < runs.size(); ++i) {
+        EXPECT_EQ(runs[i].techniqueId, order[i].first) << i;
+        EXPECT_EQ(runs[i].repeat, order[i].second) << i;
+        EXPECT_EQ(runs[i].index, i);
+    }
+    EXPECT_EQ(runs[0].timedFrames, 25);
+    EXPECT_EQ(runs[1].timedFrames, 0);  // the config's
+    EXPECT_EQ(runs[2].params.getInt("spp"), 4);
+    EXPECT_EQ(countRuns(parseExperimentConfig(j, "cfg.json", "."), 1000), 5u);
+    j["techniques"][0]["repeats"] = 0;
+    EXPECT_NE(parseError(j).find("repeats"), std::string::npos) << parseError(j);
+    j["techniques"][0]["repeats"] = 2;
+    j["techniques"][1]["params"] = {{"spp", 0}};
+    EXPECT_NE(parseError(j).find("spp"), std::string::npos) << parseError(j);
+}
+
 TEST(CpuExperimentConfig, RangesAreLinearOrLogAndIntegersRounded) {
     const auto lin = expandRange({{"linear", {0.0, 1.0, 5}}}, false, "x");
     ASSERT_EQ(lin.size(), 5u);
@@ -739,6 +767,51 @@ TEST_F(GpuRunner, BounceFloorsScoreTheExactBounceImagesAgainstTheFullReference) 
     const nlohmann::json& floors2 = r2["metrics"]["bounce_floors"];
     EXPECT_EQ(floors2["2"], nlohmann::json({{"same_as_full", true}}));
     EXPECT_TRUE(floors2["1"]["flip"]["mean"].is_number());
+}
+
+// The equal-time path-tracer baseline (pt_baseline.h): a run of technique "pathtracer" is the
+// reference renderer at `spp` samples on the CPU, scored like a technique against the full
+// reference (it claims every bounce), timed by the CPU clock; more samples, less error. A
+// repeat keeps the first run's key and adds its own.
+TEST_F(GpuRunner, PathTracerBaselineRunsLikeATechniqueOnTheCpuClock) {
+    nlohmann::json j = baseConfig();
+    j["name"] = "ptbaseline";
+    j["resolution"] = {32, 32};
+    j["reference"] = {{"spp", 64}, {"max_bounces", 8}, {"pixel_filter", "center"}};
+    j["timing"] = {{"warmup", 0}, {"frames", 3}};
+    j["techniques"] = {
+        {{"technique", "pathtracer"}, {"repeats", 2}, {"sweep", {{"grid", {{"spp", {1, 16}}}}}}}};
+    std::ofstream(m_config) << j.dump(2);
+    const RunnerSummary s = runExperiment(options());
+    ASSERT_EQ(s.ran, 4u);
+    std::map<std::pair<int, int>, nlohmann::json> bySppRepeat;
+    for (const nlohmann::json& r : RunStore(s.dir).loadFinished())
+        bySppRepeat[{r["technique"]["params"]["spp"].get<int>(), r["repeat"].get<int>()}] = r;
+    ASSERT_EQ(bySppRepeat.size(), 4u);
+    for (const auto& [k, r] : bySppRepeat) {
+        EXPECT_EQ(r["status"], "ok");
+        EXPECT_EQ(r["technique"]["id"], "pathtracer");
+        EXPECT_EQ(r["technique"]["indirect_bounces"], kAllBounces);
+        EXPECT_EQ(r["reference"]["matched"], "full");
+        EXPECT_EQ(r["device"]["type"], "cpu_path_tracer");
+        EXPECT_GT(r["timing"]["frame_cpu_ms"]["median"].get<double>(), 0.0);
+        EXPECT_FALSE(r["timing"].contains("frame_gpu_ms"));
+        EXPECT_EQ(r["timing"]["timed_frames"], 3);
+        EXPECT_TRUE(r["metrics"]["bounce_floors"]["1"]["flip"]["mean"].is_number());
+    }
+    const auto run = [&](int spp, int repeat) -> const nlohmann::json& {
+        return bySppRepeat.at(std::make_pair(spp, repeat));
+    };
+    const auto flip = [&](int spp, int repeat = 0) {
+        return run(spp, repeat)["metrics"]["final_vs_full"]["flip"]["mean"].get<double>();
+    };
+    EXPECT_LT(flip(16), flip(1));  // 16 samples are closer to the 64-sample reference
+    // Its samples are not the reference's (another seed): 16 of the reference's own 64 samples
+    // would share a quarter of its noise.
+    EXPECT_GT(run(16, 0)["metrics"]["final_vs_full"]["rel_mse"].get<double>(), 0.0);
+    // The repeat renders the same image (same seed) under another key.
+    EXPECT_NE(run(1, 0)["key"], run(1, 1)["key"]);
+    EXPECT_DOUBLE_EQ(flip(1), flip(1, 1));
 }
 
 TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {

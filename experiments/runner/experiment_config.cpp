@@ -229,9 +229,11 @@ std::vector<std::pair<std::string, std::vector<nlohmann::json>>> parseAxes(const
 }
 
 TechniqueEntry parseTechnique(const JsonNode& node, const std::set<std::string>& sceneLabels) {
-    node.expectKeys({"technique", "params", "sweep", "shared", "scenes"});
+    node.expectKeys({"technique", "params", "sweep", "shared", "scenes", "repeats", "frames"});
     TechniqueEntry t;
     t.id = node["technique"].string();
+    if (node.has("repeats")) t.repeats = node["repeats"].integerIn(1, 1000);
+    if (node.has("frames")) t.timedFrames = node["frames"].integerIn(1, 100000);
     if (node.has("scenes")) {
         // Only these scenes (labels as in "scenes"), e.g. a sweep that matters on one scene.
         const JsonNode list = node["scenes"];
@@ -417,7 +419,7 @@ size_t countRuns(const ExperimentConfig& config, size_t saturateAt) {
             for (const auto& [key, values] : t.grid)
                 n = mul(n, values.size());
             if (!t.zip.empty()) n = mul(n, t.zip.front().second.size());
-            total = add(total, n);
+            total = add(total, mul(n, size_t(t.repeats)));
         }
     return total;
 }
@@ -465,7 +467,7 @@ void checkRunCount(const ExperimentConfig& config) {
 
 std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
     checkRunCount(config);  // also for configs built in memory
-    std::vector<RunSpec> runs;
+    std::vector<RunSpec> runs, repeats;
     runs.reserve(countRuns(config, config.maxRuns));
     for (const SceneEntry& scene : config.scenes) {
         for (const TechniqueEntry& t : config.techniques) {
@@ -537,9 +539,22 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
                                     run.params.toString() + ": " + e.what());
                     }
                 }
+                run.timedFrames = t.timedFrames;
+                for (int r = 1; r < t.repeats; ++r) {  // after every block's first round
+                    RunSpec again = run;
+                    again.repeat = r;
+                    repeats.push_back(std::move(again));
+                }
                 runs.push_back(std::move(run));
             }
         }
+    }
+    // Repeat rounds: round r holds every configuration's r-th repeat, in the first round's order
+    std::stable_sort(repeats.begin(), repeats.end(),
+                     [](const RunSpec& a, const RunSpec& b) { return a.repeat < b.repeat; });
+    for (RunSpec& r : repeats) {
+        r.index = runs.size();
+        runs.push_back(std::move(r));
     }
     return runs;
 }

@@ -70,6 +70,12 @@ struct TechniqueEntry {
     std::vector<std::pair<std::string, std::vector<nlohmann::json>>> zip;
     std::map<std::string, nlohmann::json> shared;  // shared-pass overrides for this technique
     std::vector<std::string> scenes;  // scene labels this block runs on; empty = every scene
+    /** "repeats": each run this many times; repeats 1..n-1 come after every block's first
+     *  round (interleaved with the other techniques' runs), for the between-run timing spread
+     *  (docs/experiments.md, "Repeats"). */
+    int repeats = 1;
+    /** "frames": timed frames of this block's runs (0 = the config's "timing.frames"). */
+    int timedFrames = 0;
 };
 
 /** Default of "max_runs": a config whose sweeps expand to more runs is refused. */
@@ -108,6 +114,8 @@ struct RunSpec {
     ParamSet params;
     ParamSet shared;
     std::map<std::string, std::string> swept;  // swept key -> canonical value text
+    int repeat = 0;       // 0 = the first run of this configuration; r > 0: its r-th repeat
+    int timedFrames = 0;  // timed frames (0 = the config's)
 };
 
 /** Expands every technique block into runs (scenes outermost), validating every value.

@@ -43,8 +43,8 @@ ParamSet defaultRunParams(const std::string& id) {
                                : TechniqueRegistry::instance().defaultParams(id);
 }
 
-PtBaselineOutput renderPtBaseline(const Scene& scene, ref::ReferenceSettings settings,
-                                  uint32_t spp, uint64_t seed, int warmup, int frames,
+PtBaselineOutput renderPtBaseline(const Scene& scene, ref::ReferenceSettings settings, uint32_t spp,
+                                  uint64_t seed, int warmup, int frames,
                                   const std::atomic<bool>* cancel) {
     if (spp == 0) throw Error("pathtracer: spp must be at least 1");
     if (frames < 1) throw Error("pathtracer: at least one timed frame is needed");

@@ -45,8 +45,8 @@ struct PtBaselineOutput {
  * `frames` timed frames of `spp` samples per pixel; the layers are the first timed frame's.
  * Throws gilab::Error for spp == 0 or frames < 1.
  */
-PtBaselineOutput renderPtBaseline(const Scene& scene, ref::ReferenceSettings settings,
-                                  uint32_t spp, uint64_t seed, int warmup, int frames,
+PtBaselineOutput renderPtBaseline(const Scene& scene, ref::ReferenceSettings settings, uint32_t spp,
+                                  uint64_t seed, int warmup, int frames,
                                   const std::atomic<bool>* cancel = nullptr);
 
 }  // namespace gilab::exp

@@ -25,6 +25,7 @@
 #include "core/vk/context.h"
 #include "experiments/cli/run_metadata.h"
 #include "experiments/runner/experiment_config.h"
+#include "experiments/runner/pt_baseline.h"
 #include "experiments/runner/reference_set.h"
 #include "experiments/runner/run_metrics.h"
 #include "experiments/runner/run_sequence.h"
@@ -85,8 +86,26 @@ nlohmann::ordered_json runIdentityStatic(const ExperimentConfig& config, const R
             {"params", keyParams(run.params)},
             {"shared", run.shared.toOrderedJson()},
             {"warmup", config.timing.warmupFrames},
-            {"frames", config.timing.timedFrames},
+            {"frames", run.timedFrames > 0 ? run.timedFrames : config.timing.timedFrames},
             {"metrics", metricsSpecJson(config.metrics)}};
+}
+
+/** A repeat's identity: the first run's plus its index (the first run keeps its key). */
+nlohmann::ordered_json withRepeat(nlohmann::ordered_json id, const RunSpec& run) {
+    if (run.repeat > 0) id["repeat"] = run.repeat;
+    return id;
+}
+
+/** What an animation moves: "light" (a track on a light), "camera" (on the camera). */
+nlohmann::ordered_json animationMoves(const Scene& scene) {
+    std::set<std::string> moves;
+    for (const AnimationTrack& track : scene.animation.tracks) {
+        const std::string target = animationTarget(track);
+        moves.insert(target.rfind("light", 0) == 0    ? "light"
+                     : target.rfind("camera", 0) == 0 ? "camera"
+                                                      : "other");
+    }
+    return nlohmann::ordered_json(std::vector<std::string>(moves.begin(), moves.end()));
 }
 
 /** The scene at frame `frame` of its animation (lights and camera moved; same geometry). */
@@ -112,7 +131,7 @@ nlohmann::ordered_json sequenceIdentity(const ExperimentConfig& config, const Sc
  *  they had before animation existed. */
 nlohmann::ordered_json runIdentity(const ExperimentConfig& config, const RunSpec& run,
                                    const Scene& scene) {
-    nlohmann::ordered_json id = runIdentityStatic(config, run, scene);
+    nlohmann::ordered_json id = withRepeat(runIdentityStatic(config, run, scene), run);
     nlohmann::ordered_json sequence = sequenceIdentity(config, scene);
     if (!sequence.is_null()) id["sequence"] = std::move(sequence);
     return id;
@@ -325,6 +344,11 @@ void printRunLine(const nlohmann::ordered_json& row, bool quiet) {
                       number("full.flip"), number("full.rel_mse"));
         line += buf;
     }
+    if (row.value("technique", "") == kPathTracerId && number("frame_cpu_ms_median") >= 0.0) {
+        std::snprintf(buf, sizeof buf, ", frame %.2f ms (CPU path tracer)",
+                      number("frame_cpu_ms_median"));
+        line += buf;
+    }
     if (number("frame_gpu_ms_median") >= 0.0) {
         std::snprintf(buf, sizeof buf, ", %s %.2f ms (%s)",
                       number("sequence.full.flip_mean") >= 0.0 ? "static frame" : "frame",
@@ -356,22 +380,101 @@ std::string commitResult(Context& c, nlohmann::ordered_json& result, const fs::p
 }
 
 /** Executes one run into a temporary folder and commits it. Returns its status. */
-std::string executeRun(Context& c, const RunSpec& run, const std::string& key, size_t position,
-                       size_t count) {
-    const Scene& scene = c.scenes.get(*run.scene);
-    const TechniqueInfo& info = TechniqueRegistry::instance().get(run.techniqueId);
-    const fs::path tmp = c.store.beginRun(key);
-
-    nlohmann::ordered_json result;
+/** The run's identity block of result.json (shared by techniques and the path tracer). */
+void beginResult(Context& c, nlohmann::ordered_json& result, const RunSpec& run,
+                 const std::string& key, const Scene& scene) {
     result["schema"] = 1;
     result["status"] = "running";
     result["key"] = key;
     result["index"] = run.index;
+    result["repeat"] = run.repeat;
     result["experiment"] = c.config.name;
     result["scene"] = {{"label", run.scene->label},
                        {"path", run.scene->path},
                        {"variant", run.scene->variant},
                        {"resolution", {scene.settings.width, scene.settings.height}}};
+}
+
+/**
+ * The equal-time path-tracer baseline (pt_baseline.h): the reference renderer at `spp` samples
+ * per pixel on this CPU, compared with the same references and metrics as any technique. It
+ * claims every bounce. Static scenes only.
+ */
+std::string executePathTracerRun(Context& c, const RunSpec& run, const std::string& key,
+                                 size_t position, size_t count) {
+    const Scene& scene = c.scenes.get(*run.scene);
+    const fs::path tmp = c.store.beginRun(key);
+    nlohmann::ordered_json result;
+    beginResult(c, result, run, key, scene);
+    nlohmann::ordered_json swept = nlohmann::ordered_json::object();
+    for (const auto& [k, v] : run.swept)
+        swept[k] = v;
+    result["technique"] = {
+        {"id", kPathTracerId},
+        {"description",
+         "the reference path tracer at a small sample count, on the CPU (Embree, "
+         "TBB): the equal-time baseline"},
+        {"citation", ""},
+        {"indirect_bounces", kAllBounces},
+        {"params", run.params.toOrderedJson()},
+        {"swept", swept}};
+    result["provenance"] = cli::provenanceJson(c.options.commandLine);
+    result["config_hash"] = c.configHash;
+    const nlohmann::ordered_json prov = result["provenance"];
+    result["device"] = {{"name", prov.value("cpu", std::string("CPU")) + " (path tracer)"},
+                        {"type", "cpu_path_tracer"}};
+    result["host"] = hostName();
+    if (scene.animation.animated()) {
+        result["reason"] = "the path-tracer baseline times static frames only";
+        return commitResult(c, result, tmp, key, {.supported = false});
+    }
+    const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
+    const MatchedReference matched = refs.match(kAllBounces);
+    ToneMap tm;
+    tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
+    result["reference"] = {{"key", refs.result().key},
+                           {"samples", refs.result().acc.samples},
+                           {"rel_error", ref::meanRelativeStdError(refs.result().acc)},
+                           {"matched", matched.name}};
+    result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
+    std::fprintf(stderr, "[gilab] run %zu/%zu %s on %s (spp %d)\n", position, count, kPathTracerId,
+                 run.scene->label.c_str(), run.params.getInt("spp"));
+    const int timed = run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
+    PtBaselineOutput pt = renderPtBaseline(
+        scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
+        uint64_t(run.params.getInt("seed")), c.config.timing.warmupFrames, timed, c.cancel);
+    size_t nonFinite = 0;
+    result["nonfinite"] = cli::finiteJson(pt.layers, &nonFinite);
+    result["timing"] = pt.timing;
+    result["stats"] = pt.stats;
+    result["metrics"] =
+        computeRunMetrics(pt.layers, matched, kAllBounces, c.config.metrics, tm, tmp);
+    result["metrics"]["final_vs_bounces"] =
+        computeBounceLadder(pt.layers, refs, c.config.metrics, tm);
+    result["metrics"]["direct"] =
+        computeDirectMetrics(pt.layers, refs.match(0), c.config.metrics, tm);
+    result["metrics"]["bounce_floors"] = computeBounceFloors(refs, c.config.metrics, tm);
+    writeExrWithMainImage((tmp / "output.exr").string(), pt.layers, "final",
+                          {{kPixelFilterAttribute, "center"}});
+    writePngTonemapped((tmp / "final.png").string(), pt.layers[0].image, tm);
+    writePngTonemapped((tmp / "indirect.png").string(), pt.layers[1].image, tm);
+    result["outputs"] = {{"exr", "output.exr"},
+                         {"final_png", "final.png"},
+                         {"indirect_png", "indirect.png"},
+                         {"flip_png", "flip.png"},
+                         {"flip_full_png", "flip_full.png"}};
+    return commitResult(c, result, tmp, key, {.supported = true, .nonFinitePixels = nonFinite});
+}
+
+std::string executeRun(Context& c, const RunSpec& run, const std::string& key, size_t position,
+                       size_t count) {
+    if (run.techniqueId == kPathTracerId) return executePathTracerRun(c, run, key, position, count);
+    const Scene& scene = c.scenes.get(*run.scene);
+    const TechniqueInfo& info = TechniqueRegistry::instance().get(run.techniqueId);
+    const fs::path tmp = c.store.beginRun(key);
+
+    nlohmann::ordered_json result;
+    beginResult(c, result, run, key, scene);
     nlohmann::ordered_json swept = nlohmann::ordered_json::object();
     for (const auto& [k, v] : run.swept)
         swept[k] = v;
@@ -406,13 +509,14 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
                            {"matched", matched.name}};
     result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
 
+    const int timed = run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
     Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
                           info.id + " on " + run.scene->label,
-                      size_t(c.config.timing.warmupFrames + c.config.timing.timedFrames));
+                      size_t(c.config.timing.warmupFrames + timed));
     SetupTiming setup;
     std::vector<FrameTiming> frames;
     WarmupResult warmup;
-    const int total = c.config.timing.warmupFrames + c.config.timing.timedFrames;
+    const int total = c.config.timing.warmupFrames + timed;
     try {
         setup = harness->setup();
         warmup = harness->warmUp(c.config.timing.warmupFrames, [&](int i) {
@@ -423,7 +527,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
             progress.update(size_t(i + 1));
         }
         // Noisy frame times: more frames until the IQR is within target (docs/timing.md).
-        while (int(frames.size()) < c.config.timing.frameLimit() &&
+        while (int(frames.size()) < std::max(c.config.timing.frameLimit(), timed) &&
                cli::frameGpuIqrOverMedian(frames) > c.config.timing.targetIqr)
             frames.push_back(harness->renderFrame());
     } catch (const DeviceLimitError& e) {  // valid parameters this device cannot run
@@ -444,7 +548,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     {
         const double spread = cli::frameGpuIqrOverMedian(frames);
         nlohmann::ordered_json& t = result["timing"];
-        t["frames_requested"] = c.config.timing.timedFrames;
+        t["frames_requested"] = timed;
         t["target_iqr"] = c.config.timing.targetIqr;
         t["iqr_over_median"] = std::isfinite(spread) ? nlohmann::ordered_json(spread) : nullptr;
         t["noisy"] = std::isfinite(spread) && spread > c.config.timing.targetIqr;
@@ -472,6 +576,7 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
         result["timing"].update(sequence->timing);
         result["animation"] = {{"frames", scene.animation.frameCount},
                                {"duration_s", scene.animation.duration},
+                               {"moves", animationMoves(scene)},
                                {"measured_frames", measured},
                                {"update", sequence->update}};
     }

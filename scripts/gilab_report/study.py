@@ -194,6 +194,8 @@ def row_from_result(data: dict) -> dict:
     }
     for key, value in (params.items() if isinstance(params, dict) else []):
         row[f"param.{key}"] = value
+    if isinstance(d.get("repeat"), int):  # the runner's repeat index (REPEAT_KEYS)
+        row["param.repeat"] = d["repeat"]
     for prefix, path in (("full", "final_vs_full"), ("matched", "final"),
                          ("indirect", "indirect"), ("direct", "direct")):
         _metric_columns(row, prefix, dig(d, "metrics", path))
@@ -482,7 +484,7 @@ def noise_spreads(rows: list[dict]) -> tuple[dict[str, float], dict[str, float]]
     REPEAT_KEYS (verdicts.pooled_relative_spread / pooled_spread). A technique with no repeats
     is absent (its spread is unmeasured: 0 in the rules, said in the report)."""
     times: dict[str, dict[tuple, list[float]]] = {}
-    errors: dict[str, dict[tuple, list[float]]] = {}
+    errors: dict[str, dict[tuple, dict[str, list[float]]]] = {}  # tech -> config -> seed -> e
     for r in rows:
         if fstr(r.get("status")) != "ok":
             continue
@@ -492,14 +494,16 @@ def noise_spreads(rows: list[dict]) -> tuple[dict[str, float], dict[str, float]]
             t = fnum(r.get("frame_cpu_ms_median"))
         if t is not None:
             times.setdefault(tech, {}).setdefault(key, []).append(t)
-        if "seed" in _params(r) or any(k in _params(r) for k in REPEAT_KEYS):
-            e = fnum(r.get("full.flip"))
-            if e is not None:
-                errors.setdefault(tech, {}).setdefault(key, []).append(e)
+        e = fnum(r.get("full.flip"))
+        if "seed" in _params(r) and e is not None:
+            errors.setdefault(tech, {}).setdefault(key, {}).setdefault(
+                _params(r)["seed"], []).append(e)
     time_spread = {t: v for t, g in times.items()
                    if (v := V.pooled_relative_spread(g.values())) is not None}
+    # One error per seed (timing repeats of one seed give the same image), groups of >= 2 seeds
     seed_spread = {t: v for t, g in errors.items()
-                   if (v := V.pooled_spread(g.values())) is not None}
+                   if (v := V.pooled_spread([statistics.fmean(es) for es in by_seed.values()]
+                                            for by_seed in g.values())) is not None}
     return time_spread, seed_spread
 
 
@@ -638,7 +642,8 @@ def device_name(rows: list[dict]) -> str:
         if not name:
             continue
         kind = fstr(r.get("device_type"))
-        label = f"{name} (lavapipe, CPU)" if kind == "cpu" else f"{name} (GPU)" \
+        label = f"{name} (lavapipe, CPU)" if kind == "cpu" else name \
+            if kind == "cpu_path_tracer" else f"{name} (GPU)" \
             if kind in ("discrete", "integrated", "gpu", "virtual") else \
             (f"{name} ({kind})" if kind else name)
         if label not in names:

@@ -426,7 +426,8 @@ def md_verdict(study: "S.Study") -> list[str]:
     reach = S.ladder_reach(study)
     out = ["## Verdict", "",
            f"Lowest HDR-FLIP against the full reference within each frame-time budget, over "
-           f"{len(S.quality_scenes(study))} scenes; timed on {study.device}; "
+           f"{len(S.quality_scenes(study))} scene"
+           f"{'' if len(S.quality_scenes(study)) == 1 else 's'}; timed on {study.device}; "
            f"{S.DEVICE_CAVEAT}. Marks: docs/report.md, \"Verdict rules\".", "",
            "| series | " + " | ".join(f"≤ {b:g} ms" for b in study.budgets)
            + " | ladder reach | noise in the rules |",
@@ -459,7 +460,9 @@ def cost_head(device: str) -> list[str]:
 def cost_cells(c: "C.CostRow") -> list[str]:
     def t(x: Optional[float]) -> str:
         return S.sig3(x)
-    return [c.series, c.rung or "defaults", str(c.scenes) if c.scenes else "—", t(c.static_ms),
+    series = c.series + (" (CPU path tracer: its CPU clock)"
+                         if c.series.partition(" (")[0] == S.PATH_TRACER else "")
+    return [series, c.rung or "defaults", str(c.scenes) if c.scenes else "—", t(c.static_ms),
             S.sig3(c.memory_mib), t(c.setup_ms), t(c.setup_cached_ms), t(c.light_ms),
             t(c.camera_ms), S.sig3(c.payback_frames),
             S.sig3(c.split.fixed_ms) if c.split else "—",

@@ -265,8 +265,10 @@ def equal_error(series: dict[str, list[Entry]], targets: Iterable[float]) -> lis
 
 def matched_winner(v: Verdict) -> Optional[str]:
     """The column's winner on the matched basis (lowest matched error among the same best
-    entries, compensating ones included: the matched basis does not reward surplus energy)."""
-    have = {s: e for s, e in v.best.items() if e.matched is not None}
+    entries, compensating ones included: the matched basis does not reward surplus energy).
+    Entries that claim no indirect bounce are left out: their matched reference has no
+    indirect light, so they are exact on it by construction."""
+    have = {s: e for s, e in v.best.items() if e.matched is not None and e.bounces != 0}
     if not have:
         return None
     return min(have, key=lambda s: (have[s].matched, s))
