@@ -707,3 +707,34 @@ def check_device_captions(checks: Any, results_dir: str, dom: str) -> None:
                  f"every table comparing techniques ({len(tables)}) names the device model "
                  f"({', '.join(sorted(names))}) in its caption, the run table in a line above it",
                  str(bad[:2]))
+
+
+def check_verdict(checks: Any, dom: str) -> None:
+    """The first screen gives the verdict (issue 44): the study's technique x budget table
+    inside the header, under the title and above the provenance table, one row per series with
+    a cell per budget (wins / ties / borderline / compensating counts or a dash), the ladder
+    reach and the noise the rules used, then one line per quality scene."""
+    header = dom.split("</header>", 1)[0]
+    at_verdict, at_meta = header.find('id="verdict"'), header.find('class="meta"')
+    checks.check(0 <= at_verdict < at_meta and header.find("<h1") < at_verdict,
+                 "the verdict is the first screen: in the header, after the title, before the "
+                 "provenance table", f"verdict at {at_verdict}, provenance at {at_meta}")
+    block = header[at_verdict:at_meta] if at_verdict >= 0 else ""
+    heads = [strip_tags(h) for h in re.findall(r"<th[^>]*>(.*?)</th>", block, re.S)]
+    budgets = [h for h in heads if h.startswith("≤ ") and h.endswith(" ms")]
+    rows = re.findall(r"<tr>(.*?)</tr>", block.split("<tbody>", 1)[-1], re.S)
+    cells = [[strip_tags(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", r, re.S)] for r in rows]
+    form = re.compile(r"^(—|((wins|ties|borderline|compensating) \d+)(, (ties|borderline|"
+                      r"compensating) \d+)*)$")
+    ok = (len(budgets) >= 1 and heads[-2:] == ["ladder reach", "noise in the rules"]
+          and len(cells) >= 2 and all(len(c) == len(budgets) + 3 for c in cells)
+          and all(form.match(v) for c in cells for v in c[1:1 + len(budgets)])
+          and any("wins" in v for c in cells for v in c[1:1 + len(budgets)]))
+    checks.check(ok, f"the verdict table: {len(cells)} series x {len(budgets)} budgets, each "
+                 "cell a count of wins / ties / borderline / compensating scenes, with the "
+                 "ladder reach and the noise in the rules", str(cells[:3]))
+    lines = re.findall(r'<ul class="scene-verdicts">(.*?)</ul>', block, re.S)
+    items = re.findall(r"<li>(.*?)</li>", lines[0], re.S) if lines else []
+    checks.check(bool(items) and all(": " in strip_tags(i) for i in items),
+                 f"one verdict line per quality scene below the table ({len(items)})",
+                 str(items[:2]))

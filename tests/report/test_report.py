@@ -255,6 +255,7 @@ def check_main(checks: Checks, tmp: str) -> None:
     page_checks.check_animation(checks, fixture, dom)
     page_checks.check_rank_order(checks, fixture, dom, "full")
     page_checks.check_order(checks, dom)
+    page_checks.check_verdict(checks, dom)
     page_checks.check_error_maps(checks, fixture, dom)
     page_checks.check_sweeps_apart(checks, fixture, dom)
     page_checks.check_noisy(checks, fixture, dom)
