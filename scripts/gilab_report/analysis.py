@@ -11,6 +11,7 @@ from typing import Any, Callable, Optional
 
 from .data import Animation, MetricView, Run, num, text
 from .device import device_group, device_groups
+from . import verdicts as V
 from .noise import front_ties
 
 # Okabe & Ito's colour-blind-safe palette (without yellow, hard to see on white), then more.
@@ -130,20 +131,12 @@ def by_technique(runs: list[Run]) -> dict[str, list[Run]]:
 
 
 def pareto_front(runs: list[Run], error: Callable[[Run], Optional[float]]) -> list[Run]:
-    """Ok runs not dominated by another ok run: none is both faster-or-equal and lower-error.
-
-    Sorted by frame time; each point has a strictly lower error than every faster point.
-    """
-    points = [r for r in runs
-              if r.status == "ok" and r.frame_ms is not None and error(r) is not None]
-    points.sort(key=lambda r: (r.frame_ms, error(r)))
-    front: list[Run] = []
-    for run in points:
-        if not front or error(run) < error(front[-1]):
-            if front and front[-1].frame_ms == run.frame_ms:
-                front.pop()  # same time, lower error: the earlier one is dominated
-            front.append(run)
-    return front
+    """Ok runs not dominated by another ok run (verdicts.pareto: none is both faster-or-equal
+    and lower-error; of identical points the first). Sorted by frame time."""
+    ok = [r for r in runs if r.status == "ok" and r.frame_ms is not None and error(r) is not None]
+    entries = [V.Entry(key=str(i), series="", time=r.frame_ms, error=error(r))
+               for i, r in enumerate(ok)]
+    return [ok[int(e.key)] for e in V.pareto(entries)]
 
 
 @dataclass(frozen=True)

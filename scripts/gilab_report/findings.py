@@ -207,6 +207,13 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
           f"budgets {_fmt_list(list(budgets))} ms; equal-error targets "
           f"{_fmt_list(list(fractions))} × the direct floor.", ""]
     md += ladders_md(study)
+    borderline = S.borderline_lines(study)
+    md += ["## Borderline verdicts", "",
+           "Verdicts that could change within the timing or error noise (docs/report.md, "
+           "\"Verdict rules\"); the study repeats these configurations and keeps the mark if "
+           "they stay within it.", ""]
+    md += [f"- {line}" for line in borderline] or ["- none"]
+    md.append("")
     md += md_cost(study)
     md += ["## Reference noise and the direct floor", "",
            "Direct floor: the `direct` run's HDR-FLIP vs the full reference (all indirect light "
@@ -264,19 +271,19 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
     os.makedirs(out_dir, exist_ok=True)
     with open(out, "w", encoding="utf-8") as f:
         f.write("\n".join(md))
-    glance = ["| technique | lowest HDR-FLIP vs full reference (scene, frame time) | error left "
-              "vs direct (median) | wins (scene: budgets, ms) | breaks |", "|---|---|---|---|---|"]
+    common = S.common_scenes(study)
+    glance = [f"| technique | median best HDR-FLIP vs full reference ({len(common)} common "
+              "scenes) | error left vs direct (median, same scenes) | wins (scene: budgets, ms) "
+              "| breaks |", "|---|---|---|---|---|"]
     for g in S.glance(study):
-        best = g["best"]
-        where = ""
-        if best and best[2] != g["technique"]:
-            where = ", " + best[2].partition(" (")[2].rstrip(")")
         wins = "; ".join(f"{sc}: {'/'.join(b)}" for sc, b in g["wins"].items())
-        glance.append(f"| {g['technique']} | "
-                      + (f"{S.sig3(best[1].y)} ({best[0]}, {S.ms(best[1].x)}{where})"
-                         if best else "—")
+        glance.append(f"| {g['technique']} | {S.sig3(g['median_best'])}"
                       + f" | {S.sig3(g['floor_ratio']) if g['floor_ratio'] is not None else '—'}"
                       + f" | {wins or '—'} | {', '.join(g['breaks']) or '—'} |")
+    glance.append("")
+    glance.append("Common scenes (every technique has a ranked run on each): "
+                  + (", ".join(common) or "none") + ". Wins: equal-time verdicts on any quality "
+                  "scene, compensating runs never winning (docs/report.md, \"Verdict rules\").")
     glance.append("")
     glance.append(f"Timed on {study.device}, {study.machine}; commit `{commit}`, {date}; "
                   f"from {os.path.basename(out)} (`{command}`).")

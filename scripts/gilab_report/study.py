@@ -314,10 +314,11 @@ def cached_setup(row: dict) -> bool:
 
 
 def ladder_keys(rows: list[dict]) -> dict[str, set[str]]:
-    """technique -> the union of its runs' swept keys (its ladder's knobs)."""
+    """technique -> the union of its runs' swept keys (its ladder's knobs), repeat keys (a
+    sweep over `seed`) left out: they repeat a rung, they are not one."""
     out: dict[str, set[str]] = {}
     for r in rows:
-        keys = fstr(r.get("swept")).split()
+        keys = [k for k in fstr(r.get("swept")).split() if k not in REPEAT_KEYS]
         out.setdefault(fstr(r.get("technique")), set()).update(keys)
     return out
 
@@ -439,6 +440,7 @@ def _entry(p: Point) -> V.Entry:
     return V.Entry(key=p.key, series=p.series, time=p.x if p.ranked else None,
                    error=p.y if p.ranked else None, error_sigma=p.y_sigma or 0.0,
                    matched=fnum(p.row.get("matched.flip")),
+                   energy=fnum(p.row.get("energy_ratio")),
                    matched_sigma=fnum(p.row.get("matched.flip_noise")) or 0.0,
                    bounces=b, floor=floor, floor_sigma=floor_sigma or 0.0)
 
@@ -546,13 +548,19 @@ class Column:
     borderline: bool = False  # the winner could change within the timing or error noise
     borderline_why: list[str] = field(default_factory=list)
     compensating: list[str] = field(default_factory=list)  # would win, but compensate
+    calibration: dict[str, str] = field(default_factory=dict)  # path tracer vs the winner
     matched_winner: Optional[str] = None  # the winner on the bounce-matched basis
 
     def rank(self, cells: dict[str, Cell]) -> list[str]:
         """The winners among `cells` (verdicts.verdict on their points)."""
         series = {s: [c.point] for s, c in cells.items() if c.point is not None}
         return V.verdict({s: [p.entry for p in ps] for s, ps in series.items()}, self.limit,
-                         self.by_time).winners
+                         self.by_time, calibration=calibration_series(series)).winners
+
+
+def calibration_series(series: Iterable[str]) -> list[str]:
+    """The series that calibrate rather than compete: the equal-time path tracer's."""
+    return [s for s in series if s.partition(" (")[0] == PATH_TRACER]
 
 
 def _columns(series_points: dict[str, list[Point]], limits: Iterable[float],
@@ -564,10 +572,14 @@ def _columns(series_points: dict[str, list[Point]], limits: Iterable[float],
     entries = {s: [p.entry for p in pts if p.ranked] for s, pts in series_points.items()}
     for lim in limits:
         label = f"HDR-FLIP ≤ {sig3(lim)}" if by_time else f"≤ {lim:g} ms"
-        v = V.verdict(entries, lim, by_time)
+        v = V.verdict(entries, lim, by_time, calibration=calibration_series(series_points))
         col = Column(label=label, limit=lim, by_time=by_time, winners=v.winners,
                      borderline=v.borderline, borderline_why=v.borderline_why,
-                     compensating=v.compensating, matched_winner=V.matched_winner(v))
+                     compensating=v.compensating, calibration=v.calibration,
+                     matched_winner=V.matched_winner(
+                         V.Verdict(limit=lim, by_time=by_time,
+                                   best={k: e for k, e in v.best.items()
+                                         if k not in v.calibration})))
         for s in series_points:
             e = v.best.get(s)
             col.cells[s] = Cell(by_entry[id(e)] if e is not None else None,
@@ -682,6 +694,12 @@ def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
         own = (p.x_iqr / 2.0 / p.x) if p.x_iqr and p.x else 0.0
         p.entry.time_spread = time_spread.get(tech, own)
         p.entry.seed_sigma = seed_spread.get(tech, 0.0)
+    # The shared direct light's own displacement of the full-basis score (verdicts.Entry
+    # .floor_margin): the `direct` run's error against floor 0, on this scene.
+    shift = [abs(p.y - p.entry.floor) for p in points
+             if p.ranked and fstr(p.row.get("technique")) == BASELINE and p.entry.floor is not None]
+    for p in points:
+        p.entry.floor_margin = max(shift) if shift else 0.0
     V.flag_compensation([p.entry for p in points if p.ranked])
     series: dict[str, list[Point]] = {}
     for p in sorted(points, key=lambda p: (p.x is None, p.x or 0.0, p.y or 0.0)):
@@ -1061,29 +1079,42 @@ def findings(study: Study) -> list[str]:
     return out
 
 
+def common_scenes(study: Study) -> list[str]:
+    """The quality scenes on which every technique of the study has a ranked run: the one scene
+    set cross-scene summaries use, so no technique's median stands on other scenes than
+    another's (issue 44)."""
+    techniques = {s.partition(" (")[0] for s in study.series}
+    out = []
+    for sc, st in quality_scenes(study).items():
+        ran = {p.series.partition(" (")[0] for p in st.points if p.ranked}
+        if techniques <= ran:
+            out.append(sc)
+    return out
+
+
 def glance(study: Study) -> list[dict]:
-    """Per technique (all its series together): its lowest HDR-FLIP over the quality scenes
-    (scene, time, series), the median over those scenes of its best HDR-FLIP over the direct
-    floor's (how much of the error without indirect light it leaves; HDR-FLIP of two scenes is
-    not comparable, this ratio is), the scenes and budgets where one of its series wins, and
-    what broke (a flag of only some of its series names them)."""
+    """Per technique (all its series together), over the common scenes (common_scenes): the
+    median of its best HDR-FLIP, the median of that over the direct floor's (how much of the
+    error without indirect light it leaves), the scenes and budgets where one of its series wins
+    (any quality scene), and what broke (a flag of only some of its series names them)."""
     out = []
     by_series = {b.series: b for b in study.breaks}
     quality = quality_scenes(study)
+    common = common_scenes(study)
     techniques = list(dict.fromkeys(s.partition(" (")[0] for s in study.series))
     for tech in techniques:
         series = [s for s in study.series if s.partition(" (")[0] == tech]
         bests, ratios = [], []
-        for sc, st in quality.items():
+        for sc in common:
+            st = quality[sc]
             pts = [(st.best(s), s) for s in series if st.best(s)]
             if not pts:
                 continue
             p, s = min(pts, key=lambda t: (t[0].y, t[0].x))
-            bests.append((sc, p, s))
+            bests.append(p.y)
             floor = st.direct_floor
             if tech != BASELINE and floor is not None and floor.y and floor.y > 0:
                 ratios.append(p.y / floor.y)
-        top = min(bests, key=lambda t: (t[1].y, t[1].x)) if bests else None
         wins: dict[str, list[str]] = {}
         for sc, st in quality.items():
             for col in st.equal_time:
@@ -1097,7 +1128,8 @@ def glance(study: Study) -> list[dict]:
         breaks = [f if len(who) == len(series) or len(series) == 1 else
                   f"{f} ({'; '.join(w.partition(' (')[2].rstrip(')') or w for w in who)})"
                   for f, who in flags.items()]
-        out.append({"technique": tech, "series": series, "best": top,
+        out.append({"technique": tech, "series": series, "scenes": len(common),
+                    "median_best": statistics.median(bests) if bests else None,
                     "floor_ratio": statistics.median(ratios) if ratios else None,
                     "wins": wins, "breaks": breaks})
     return out
@@ -1116,6 +1148,7 @@ class VerdictCell:
 
     wins: list[str] = field(default_factory=list)  # scenes it wins outright
     ties: list[str] = field(default_factory=list)  # scenes it ties the winner
+    beats: list[str] = field(default_factory=list)  # calibration: scenes it beats the winner
     borderline: list[str] = field(default_factory=list)  # of those, where the verdict is
     compensating: list[str] = field(default_factory=list)  # scenes it would win by compensating
 
@@ -1129,6 +1162,8 @@ class VerdictCell:
             parts.append(f"borderline {len(self.borderline)}")
         if self.compensating:
             parts.append(f"compensating {len(self.compensating)}")
+        if self.beats:
+            parts.append(f"beats the winner {len(self.beats)}")
         return ", ".join(parts) or "—"
 
 
@@ -1154,18 +1189,20 @@ def verdict_table(study: Study) -> dict[str, list[VerdictCell]]:
                     cell.borderline.append(sc)
             for s in col.compensating:
                 out[s][i].compensating.append(sc)
+            for s, standing in col.calibration.items():
+                (out[s][i].beats if standing == "beats" else
+                 out[s][i].ties if standing == "ties" else []).append(sc)
     return out
 
 
 def ladder_reach(study: Study) -> dict[str, tuple[float, float, int]]:
-    """series -> (fastest, slowest frame time, scenes) of its ranked rungs on the quality
-    scenes: what budgets its ladder can reach."""
+    """series -> (fastest, slowest static frame time, scenes) of its ranked rungs on the static
+    quality scenes: what budgets its ladder can reach."""
     out: dict[str, tuple[float, float, int]] = {}
     for s in study.series:
-        times = [p.x for st in quality_scenes(study).values() for p in st.series.get(s, [])
-                 if p.ranked]
-        scenes = sum(1 for st in quality_scenes(study).values()
-                     if any(p.ranked for p in st.series.get(s, [])))
+        static = [st for st in quality_scenes(study).values() if not st.animated]
+        times = [p.x for st in static for p in st.series.get(s, []) if p.ranked]
+        scenes = sum(1 for st in static if any(p.ranked for p in st.series.get(s, [])))
         if times:
             out[s] = (min(times), max(times), scenes)
     return out
@@ -1181,6 +1218,8 @@ def _column_words(col: Column) -> str:
         w += f" [compensating, not ranked: {', '.join(col.compensating)}]"
     if col.matched_winner and col.winners and col.matched_winner != col.winners[0]:
         w += f" [matched basis: {col.matched_winner}]"
+    for s, standing in col.calibration.items():
+        w += f" [{s} {standing} it]"
     return w
 
 
@@ -1196,4 +1235,18 @@ def scene_lines(study: Study) -> list[str]:
         parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_error]
         parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_time]
         out.append(f"{sc}: " + "; ".join(parts))
+    return out
+
+
+def borderline_lines(study: Study) -> list[str]:
+    """Every borderline verdict (equal time and equal error) on the quality scenes, with why and
+    the winner's run key: what the study repeats (>= 20 timed frames, interleaved, the config's
+    "repeats") before it keeps or drops the mark."""
+    out = []
+    for sc, st in quality_scenes(study).items():
+        for col in st.equal_error + st.equal_time:
+            if col.borderline and col.winners:
+                p = col.cells[col.winners[0]].point
+                out.append(f"{sc}, {col.label}: {col.winners[0]} (run {p.key if p else '?'}); "
+                           + "; ".join(col.borderline_why))
     return out

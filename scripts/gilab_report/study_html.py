@@ -411,7 +411,8 @@ def verdict_screen_html(study: "S.Study", colors: dict[str, str]) -> str:
                       f"wins: {', '.join(c.wins)}" if c.wins else "",
                       f"ties: {', '.join(c.ties)}" if c.ties else "",
                       f"borderline: {', '.join(c.borderline)}" if c.borderline else "",
-                      f"compensating: {', '.join(c.compensating)}" if c.compensating else "")
+                      f"compensating: {', '.join(c.compensating)}" if c.compensating else "",
+                      f"beats the winner: {', '.join(c.beats)}" if c.beats else "")
                            if x), c.text()) for c in table[s]]
         rows.append((Markup(_sw(s, colors)), cells, _reach_words(reach.get(s)),
                      _noise_words(study, s)))

@@ -28,8 +28,9 @@ Two times tie when |t_a - t_b| <= sqrt((r_a t_a)^2 + (r_b t_b)^2) (r = relative 
 The same rule serves every table; with no spread measured only equal values tie.
 
 Compensation.  A run is *compensating* when (a) its full-basis error is below the floor of its
-bounce count by more than the noise (a perfect image of the bounces it claims would score
-worse: the surplus energy stands in for the bounces it leaves out), or (b) it beats a rival
+bounce count by more than the noise and the shared direct light's own displacement (a perfect
+image of the bounces it claims would score worse: the surplus energy stands in for the bounces
+it leaves out), or (b) it beats a rival
 that claims the same bounces on the full basis while that rival beats it on the matched basis,
 both beyond the noise (the ranking flips with the basis). A compensating run is shown beside
 the headline, marked, never as its winner.
@@ -64,6 +65,13 @@ class Entry:
     bounces: Optional[int] = None
     floor: Optional[float] = None
     floor_sigma: float = 0.0
+    # How far the shared direct light alone moves the full-basis score: |error of the scene's
+    # `direct` run - floor 0| (its shadow maps and light sampling against the path tracer's).
+    # Every technique is built on that direct light, so rule (a) does not count it.
+    floor_margin: float = 0.0
+    # Indirect energy over the matched reference's (metrics.energy_ratio): rule (b) needs a
+    # surplus (> 1), the measured cause of a better full-basis rank. None: not measured.
+    energy: Optional[float] = None
     compensating: bool = False
     compensation: list[str] = field(default_factory=list)  # why, in words
 
@@ -125,35 +133,47 @@ def below_floor(e: Entry) -> bool:
     if e.error is None or e.floor is None or e.bounces in (None, ALL_BOUNCES):
         return False
     noise = math.sqrt(e.error_sigma ** 2 + e.floor_sigma ** 2 + e.seed_sigma ** 2)
-    return e.error < e.floor - noise
+    return e.error < e.floor - noise - e.floor_margin
 
 
-def basis_reversal(a: Entry, b: Entry) -> bool:
-    """Rule (b): a beats b on the full basis and b beats a on the matched one, both beyond the
-    noise, and the two claim the same bounces (so their matched references are the same)."""
-    if a.bounces is None or a.bounces != b.bounces:
-        return False
-    if None in (a.error, b.error, a.matched, b.matched):
-        return False
-    full_win = b.error - a.error > error_bound(a, b)
-    matched_noise = math.sqrt(a.matched_sigma ** 2 + b.matched_sigma ** 2 + a.seed_sigma ** 2 +
-                              b.seed_sigma ** 2)
-    matched_loss = a.matched - b.matched > matched_noise
-    return full_win and matched_loss
+def _matched_noise(a: Entry, b: Entry) -> float:
+    return math.sqrt(a.matched_sigma ** 2 + b.matched_sigma ** 2 + a.seed_sigma ** 2 +
+                     b.seed_sigma ** 2)
+
+
+def basis_ranks(e: Entry, group: list[Entry]) -> tuple[int, int]:
+    """Rule (b)'s ranks of e among `group` (entries claiming its bounces, so one matched
+    reference): (rivals clearly better on the full basis, rivals clearly better on the matched
+    basis), "clearly" meaning beyond the noise of the difference."""
+    full = sum(1 for q in group if q is not e and e.error - q.error > error_bound(e, q))
+    matched = sum(1 for q in group
+                  if q is not e and e.matched - q.matched > _matched_noise(e, q))
+    return full, matched
 
 
 def flag_compensation(entries: list[Entry]) -> list[Entry]:
-    """Sets `compensating` and `compensation` (the reasons) on every entry of one scene."""
+    """Sets `compensating` and `compensation` (the reasons) on every entry of one scene: rule
+    (a), below its bounce floor; rule (b), it ranks better on the full basis than on the
+    matched one among the runs that claim its bounces (beyond the noise)."""
     for e in entries:
         e.compensating, e.compensation = False, []
         if below_floor(e):
             e.compensation.append(f"full-basis error {e.error:.3g} below the {e.bounces}-bounce "
                                   f"floor {e.floor:.3g}")
-    for a in entries:
-        for b in entries:
-            if a is not b and basis_reversal(a, b):
-                a.compensation.append(f"beats {b.series} on the full basis, loses to it on the "
-                                      "matched one")
+    groups: dict[int, list[Entry]] = {}
+    for e in entries:
+        if e.bounces is not None and e.error is not None and e.matched is not None:
+            groups.setdefault(e.bounces, []).append(e)
+    for group in groups.values():
+        for e in group:
+            full, matched = basis_ranks(e, group)
+            if full < matched and (e.energy is None or e.energy > 1.0):
+                e.compensation.append(
+                    f"ranks {full + 1} of {len(group)} on the full basis but {matched + 1} on "
+                    f"the matched one (runs claiming {e.bounces} bounce"
+                    f"{'' if e.bounces == 1 else 's'})"
+                    + (f", with {e.energy:.3g}x the matched indirect energy"
+                       if e.energy is not None else ""))
     for e in entries:
         e.compensating = bool(e.compensation)
     return entries
@@ -164,11 +184,17 @@ def flag_compensation(entries: list[Entry]) -> list[Entry]:
 # ------------------------------------------------------------------------------------------------
 def pareto(entries: Iterable[Entry]) -> list[Entry]:
     """Ranked entries no other beats in both respects (time <= and error <, or time < and
-    error <=), by time."""
+    error <=), by time; of entries with the same time and error only the first is on the front
+    (the others are its ties)."""
     ranked = [e for e in entries if e.ranked]
-    front = [e for e in ranked if not any(
-        (q.time <= e.time and q.error < e.error) or (q.time < e.time and q.error <= e.error)
-        for q in ranked)]
+    front, seen = [], set()
+    for e in ranked:
+        if (e.time, e.error) in seen or any(
+                (q.time <= e.time and q.error < e.error) or (q.time < e.time and q.error <= e.error)
+                for q in ranked):
+            continue
+        seen.add((e.time, e.error))
+        front.append(e)
     return sorted(front, key=lambda e: (e.time, e.error))
 
 
@@ -181,6 +207,9 @@ class Verdict:
     best: dict[str, Entry] = field(default_factory=dict)  # series -> its best entry within limit
     winners: list[str] = field(default_factory=list)  # the winner, then its ties (by name)
     compensating: list[str] = field(default_factory=list)  # compensating series that beat it
+    # Calibration series (the equal-time path tracer) never win; each one's standing against
+    # the winner: "beats" (clearly better), "ties" (within the noise) or "loses".
+    calibration: dict[str, str] = field(default_factory=dict)
     borderline: bool = False
     borderline_why: list[str] = field(default_factory=list)
 
@@ -204,25 +233,36 @@ def _rank(best: dict[str, Entry], by_time: bool) -> list[str]:
     return [name] + sorted(s for s, e in best.items() if s != name and tie(e, best[name]))
 
 
-def verdict(series: dict[str, list[Entry]], limit: float, by_time: bool = False) -> Verdict:
+def verdict(series: dict[str, list[Entry]], limit: float, by_time: bool = False,
+            calibration: Iterable[str] = ()) -> Verdict:
     """Equal time (by_time False: the lowest error with time <= limit) or equal error (the
     least time with error <= limit) over each series' best entry; compensating entries never
-    win, and those that would beat the winner are listed."""
+    win, and those that would beat the winner are listed. `calibration` series (the
+    equal-time path tracer) are not candidates: each is compared with the winner instead."""
+    calibration = set(calibration)
     v = Verdict(limit=limit, by_time=by_time)
     for s, pts in series.items():
         b = _best_within(pts, limit, by_time)
         if b is not None:
             v.best[s] = b
-    honest = {s: e for s, e in v.best.items() if not e.compensating}
+    honest = {s: e for s, e in v.best.items() if not e.compensating and s not in calibration}
     v.winners = _rank(honest, by_time)
     if not v.winners:
-        v.compensating = sorted(s for s, e in v.best.items() if e.compensating)
+        v.compensating = sorted(s for s, e in v.best.items()
+                                if e.compensating and s not in calibration)
+        v.calibration = {s: "beats" for s in calibration if s in v.best}
         return v
     w = v.best[v.winners[0]]
     key = (lambda e: e.time) if by_time else (lambda e: e.error)
     v.compensating = sorted(s for s, e in v.best.items()
-                            if e.compensating and key(e) < key(w))
-    _mark_borderline(v, series, w)
+                            if e.compensating and key(e) < key(w) and s not in calibration)
+    tie = time_tie if by_time else error_tie
+    for s in calibration:
+        c = v.best.get(s)
+        if c is not None:
+            v.calibration[s] = ("ties" if tie(c, w) else
+                                "beats" if key(c) < key(w) else "loses")
+    _mark_borderline(v, {s: pts for s, pts in series.items() if s not in calibration}, w)
     return v
 
 

@@ -724,8 +724,8 @@ def check_verdict(checks: Any, dom: str) -> None:
     budgets = [h for h in heads if h.startswith("≤ ") and h.endswith(" ms")]
     rows = re.findall(r"<tr>(.*?)</tr>", block.split("<tbody>", 1)[-1], re.S)
     cells = [[strip_tags(c) for c in re.findall(r"<td[^>]*>(.*?)</td>", r, re.S)] for r in rows]
-    form = re.compile(r"^(—|((wins|ties|borderline|compensating) \d+)(, (ties|borderline|"
-                      r"compensating) \d+)*)$")
+    form = re.compile(r"^(—|((wins|ties|borderline|compensating|beats the winner) \d+)"
+                      r"(, (ties|borderline|compensating|beats the winner) \d+)*)$")
     ok = (len(budgets) >= 1 and heads[-2:] == ["ladder reach", "noise in the rules"]
           and len(cells) >= 2 and all(len(c) == len(budgets) + 3 for c in cells)
           and all(form.match(v) for c in cells for v in c[1:1 + len(budgets)])

@@ -64,7 +64,7 @@ class Compensation(unittest.TestCase):
         c = entry("c", 20, 0.50, sigma=0.01, matched=0.05, bounces=2)  # other basis: no pair
         V.flag_compensation([a, b, c])
         self.assertTrue(a.compensating)
-        self.assertIn("loses to it on the matched one", a.compensation[0])
+        self.assertIn("ranks 1 of 2 on the full basis but 2 on the matched one", a.compensation[0])
         self.assertFalse(b.compensating)
         self.assertFalse(c.compensating)
 
@@ -134,6 +134,22 @@ class SeedSpread(unittest.TestCase):
         self.assertAlmostEqual(col.cells["ssvp"].point.y, 0.44)
         self.assertEqual(col.winners, ["ssvp", "vct"])  # |0.03| <= sqrt(2e-4 + 0.04^2)
         self.assertEqual(list(study.scenes["s"].series), ["ssvp", "vct"])  # seed: no new series
+
+
+class Calibration(unittest.TestCase):
+    def test_the_path_tracer_is_compared_with_the_winner_never_the_winner(self):
+        rows = [row("s", "direct", 5, 0.9), row("s", "vct", 30, 0.5, sigma=0.01),
+                row("s", "pathtracer", 20, 0.3, sigma=0.01, swept="spp", spp=4),
+                row("s", "pathtracer", 45, 0.49, sigma=0.01, swept="spp", spp=16, key="pt16")]
+        study = S.analyse(rows, budgets=(25, 50))
+        t25, t50 = study.scenes["s"].equal_time
+        self.assertEqual(t25.winners, ["direct"])
+        self.assertEqual(t25.calibration, {"pathtracer": "beats"})
+        self.assertEqual(t50.winners, ["vct"])
+        self.assertEqual(t50.calibration, {"pathtracer": "beats"})
+        cells = S.verdict_table(study)["pathtracer"]
+        self.assertEqual([c.text() for c in cells], ["beats the winner 1"] * 2)
+        self.assertIn("[pathtracer beats it]", S.scene_lines(study)[0])
 
 
 class Cost(unittest.TestCase):
@@ -262,6 +278,21 @@ class ReportAndFindingsAgree(unittest.TestCase):
         self.assertEqual(md_cells[0][:2], ["dvs; compensating: ssvp", "vct; compensating: ssvp"])
         self.assertEqual(len(md_cells), 2)  # equal time, equal error
         self.assertEqual(md_cells, html_rows)
+
+
+class CommonScenes(unittest.TestCase):
+    def test_cross_scene_medians_use_one_scene_set(self):
+        # vct ran s and t, ssvp only s: both summaries stand on s alone (t's 0.1 would flatter
+        # vct against a technique that never ran t).
+        rows = [row("s", "direct", 5, 1.0), row("t", "direct", 5, 1.0),
+                row("s", "vct", 30, 0.6), row("t", "vct", 30, 0.1), row("s", "ssvp", 30, 0.5)]
+        study = S.analyse(rows, budgets=(50,))
+        self.assertEqual(S.common_scenes(study), ["s"])
+        g = {x["technique"]: x for x in S.glance(study)}
+        self.assertEqual(g["vct"]["median_best"], 0.6)
+        self.assertEqual(g["vct"]["floor_ratio"], 0.6)
+        self.assertEqual(g["ssvp"]["median_best"], 0.5)
+        self.assertEqual(g["vct"]["wins"], {"t": ["≤50"]})  # wins still count on any scene
 
 
 class CleanCommit(unittest.TestCase):
