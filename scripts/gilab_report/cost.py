@@ -23,6 +23,7 @@ class CostRow:
     scenes: int = 0  # quality scenes with a ranked static frame
     static_ms: Optional[float] = None  # median over those scenes
     memory_mib: Optional[float] = None  # median total Vulkan memory (scene + shared + technique)
+    own_memory_mib: Optional[float] = None  # median of the technique's own allocations
     setup_ms: Optional[float] = None  # median cold set-up
     setup_cached_ms: Optional[float] = None  # median set-up that loaded a cached precomputation
     light_ms: Optional[float] = None  # the frame where the light moves (update included)
@@ -84,6 +85,8 @@ def whole_cost(study: "S.Study") -> list[CostRow]:
         c.static_ms = _med([_static_ms(r) for r in rs])
         mem = [S.fnum(r.get("memory_total_bytes")) for r in rs]
         c.memory_mib = _med([m / 2 ** 20 for m in mem if m is not None])
+        own = [S.fnum(r.get("memory_technique_bytes")) for r in rs]
+        c.own_memory_mib = _med([m / 2 ** 20 for m in own if m is not None])
         c.setup_ms = _med([S.fnum(r.get("setup_ms")) for r in rs if not S.cached_setup(r)])
         c.setup_cached_ms = _med([S.fnum(r.get("setup_ms")) for r in rs if S.cached_setup(r)])
     _splits(study, rows)

@@ -182,6 +182,11 @@ def row_from_result(data: dict) -> dict:
         "animation_moves": " ".join(m for m in dig(d, "animation", "moves") or []
                                     if isinstance(m, str)) or None,
         "memory_total_bytes": dig(d, "memory", "total_bytes"),
+        # The technique's own allocations: every owner but the scene and the shared passes.
+        "memory_technique_bytes": sum(v for k, v in (dig(d, "memory", "by_owner") or {}).items()
+                                      if k not in ("scene", "shared")
+                                      and isinstance(v, (int, float)))
+        if isinstance(dig(d, "memory", "by_owner"), dict) else None,
         "reference_matched": dig(d, "reference", "matched"),
         "energy_ratio": dig(d, "metrics", "energy_ratio"),
         "direct.energy_ratio": dig(d, "metrics", "direct", "energy_ratio"),

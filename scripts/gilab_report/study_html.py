@@ -130,7 +130,7 @@ def _quantize(path: str) -> None:
 
 
 # ------------------------------------------------------------------------------------------------
-# HTML (the report)
+# HTML (the report): the data for templates/study_*.html.j2
 # ------------------------------------------------------------------------------------------------
 def _e(x: object) -> str:
     return html.escape(str(x), quote=True)
@@ -140,16 +140,16 @@ def _sw(s: str, colors: dict[str, str]) -> str:
     return (f'<span class="sw" style="background:{colors.get(s, "#888")}"></span>{_e(s)}')
 
 
-def _cell(c: "S.Cell", value: str, tip: str) -> str:
+def _cell(c: "S.Cell", value: str, tip: str) -> Optional[dict]:
+    """A table cell for study_table.html.j2: None ("—") or its class, title, key, value, mark."""
     if c.point is None:
-        return "<td>—</td>"
-    cls = ' class="best"' if c.best else (' class="tie"' if c.tie else
-                                          (' class="comp"' if c.compensating else ""))
+        return None
+    cls = "best" if c.best else ("tie" if c.tie else ("comp" if c.compensating else ""))
     mark = " (best)" if c.best else (" (tie)" if c.tie else
                                      (" (compensating)" if c.compensating else ""))
     if c.compensating:
         tip += "; compensating: " + "; ".join(c.point.entry.compensation)
-    return f'<td{cls} title="{_e(tip)}" data-key="{_e(c.point.key)}">{value}{mark}</td>'
+    return {"cls": cls, "title": tip, "key": c.point.key, "value": Markup(value), "mark": mark}
 
 
 def _point_tip(p: "S.Point") -> str:
@@ -158,30 +158,34 @@ def _point_tip(p: "S.Point") -> str:
             + (f" (IQR {S.ms(p.x_iqr)})" if p.x_iqr else "")).replace("  ", " ")
 
 
-def _table(columns: list["S.Column"], series: list[str], colors: dict[str, str], caption: str,
-           head: str, value) -> str:
+def _table_data(columns: list["S.Column"], series: list[str], colors: dict[str, str],
+                caption: str, head: str, value) -> Optional[dict]:
+    """study_table.html.j2's t (None without columns); caption and value(point): HTML."""
     if not columns:
-        return ""
+        return None
     rows = []
     for s in series:
-        cells = "".join(_cell(c.cells.get(s, S.Cell()), value(c.cells[s].point)
-                              if c.cells.get(s) and c.cells[s].point else "—",
-                              _point_tip(c.cells[s].point) if c.cells.get(s) and
-                              c.cells[s].point else "")
-                        for c in columns)
-        rows.append(f"<tr><td>{_sw(s, colors)}</td>{cells}</tr>")
-    winners = "".join(f'<td title="{_e("; ".join(c.borderline_why))}">'
-                      f"{_e(winners_text(c))}</td>" for c in columns)
-    matched = "".join(f"<td>{_e(matched_text(c))}</td>" for c in columns)
-    heads = "".join(f"<th>{_e(c.label)}</th>" for c in columns)
-    return (f'<table class="data study"><caption class="device-line">{caption}</caption>'
-            f"<thead><tr><th>{_e(head)}</th>{heads}</tr></thead><tbody>{''.join(rows)}"
-            f'<tr class="winners"><td>best (and ties)</td>{winners}</tr>'
-            f'<tr class="matched"><td>best on the matched basis</td>{matched}</tr>'
-            "</tbody></table>")
+        cells = []
+        for c in columns:
+            cell = c.cells.get(s)
+            p = cell.point if cell else None
+            cells.append(_cell(cell or S.Cell(), value(p) if p else "—",
+                               _point_tip(p) if p else ""))
+        rows.append((Markup(_sw(s, colors)), cells))
+    return {"caption": Markup(caption), "head": head, "heads": [c.label for c in columns],
+            "rows": rows,
+            "winners": [("; ".join(c.borderline_why), winners_text(c)) for c in columns],
+            "matched": [matched_text(c) for c in columns]}
 
 
-def breaks_table(study: "S.Study", colors: dict[str, str], caption: str, device: str) -> str:
+def _table(columns: list["S.Column"], series: list[str], colors: dict[str, str], caption: str,
+           head: str, value) -> str:
+    t = _table_data(columns, series, colors, caption, head, value)
+    return render("study_table.html.j2", t=t) if t else ""
+
+
+def _breaks_data(study: "S.Study", colors: dict[str, str], caption: str, device: str) -> dict:
+    """study_breaks.html.j2's b; caption: HTML."""
     rows = []
     for b in study.breaks:
         temporal = "; ".join(f"{sc} {S.sig3(v)}" + (f" (floor {S.sig3(f)})" if f else "")
@@ -189,51 +193,55 @@ def breaks_table(study: "S.Study", colors: dict[str, str], caption: str, device:
         fails = "; ".join([f"unsupported: {x}" for x in b.unsupported]
                           + [f"NaN/Inf: {x}" for x in b.nonfinite]
                           + [f"validation: {x}" for x in b.invalid]) or "—"
-        leak = {None: "—", True: "leaks", False: "no"}[b.leak]
-        energy = energy_range(b)
-        setup = setup_range(b)
-        flag = ' class="flag"'
-        rows.append(
-            f"<tr><td>{_sw(b.series, colors)}</td>"
-            f"<td{flag if b.leak else ''}>{leak}<br><small>{_e(b.leak_words)}</small></td>"
-            f"<td{flag if b.energy_flag else ''}>{energy}</td>"
-            f"<td{flag if b.temporal_flag else ''}>{_e(temporal)}</td><td>{setup}</td>"
-            f"<td{flag if fails != '—' else ''}>{_e(fails)}</td>"
-            f"<td>{_e('; '.join(b.audit) or '—')}</td></tr>")
-    return (f'<table class="data study breaks"><caption class="device-line">{caption}</caption>'
-            f"<thead><tr><th>series</th><th>leak ({S.LEAK_CLOSED} vs {S.LEAK_OPEN})</th>"
-            f"<th>energy ratio range (indirect vs bounce-matched)</th>"
-            f"<th>temporal instability vs the bounce-matched frames (animated scenes)</th>"
-            f"<th>set-up, {_e(device)}, ms (range)</th><th>unsupported / NaN / invalid</th>"
-            f"<th>audit: thin-wall and leak cells</th></tr></thead>"
-            f"<tbody>{''.join(rows)}</tbody></table>")
+        rows.append({"swatch": Markup(_sw(b.series, colors)),
+                     "leak": {None: "—", True: "leaks", False: "no"}[b.leak],
+                     "leak_flag": bool(b.leak), "leak_words": b.leak_words,
+                     "energy": energy_range(b), "energy_flag": bool(b.energy_flag),
+                     "temporal": temporal, "temporal_flag": bool(b.temporal_flag),
+                     "setup": setup_range(b), "fails": fails, "fails_flag": fails != "—",
+                     "audit": "; ".join(b.audit) or "—"})
+    return {"caption": Markup(caption), "device": device, "leak_closed": S.LEAK_CLOSED,
+            "leak_open": S.LEAK_OPEN, "rows": rows}
 
 
-RULES_HTML = (
-    "<p class=\"rules\">Series: a technique, split by the parameters that are not on its ladder "
-    "but differ between its runs of a scene (cvgi's <code>gather</code>). x: the median frame "
-    "time (static frame; on animated scenes the dynamic frame with its update); error: mean "
-    "HDR-FLIP vs the full reference (animated: the mean over the measured frames). "
-    "<b>Pareto front</b>: runs of all series that no run beats in both time and error. "
-    "<b>Equal time</b>: each series' lowest error with frame time ≤ the budget; a series is "
-    "<b>tied</b> with the best when |e − e<sub>best</sub>| ≤ √(σ² + σ<sub>best</sub>²), σ the "
-    "HDR-FLIP error bar from the reference noise (0 where not recorded: then only equal "
-    "errors tie). <b>Equal error</b>: targets are {fractions} × the scene's direct floor (the "
-    "<code>direct</code> run's HDR-FLIP); each series' least time reaching the target; tied "
-    "when |t − t<sub>best</sub>| ≤ (IQR + IQR<sub>best</sub>) / 2. <b>Leak</b> (door closed: "
-    "room B must stay black): energy ratio closed/open of a rung > {ratio}, or HDR-FLIP vs the "
-    "black reference > {flip}, or indirect light seen with the door closed > {share} % of the "
-    "open room's reference indirect light. Energy ratio flagged outside [{e0}, {e1}]; temporal "
-    "instability (against the bounce-matched frames) flagged above {tf} × the lowest of any GI "
-    "technique on the scene. docs/report.md, \"Cross-technique "
-    "study\".</p>")
+def breaks_table(study: "S.Study", colors: dict[str, str], caption: str, device: str) -> str:
+    return render("study_breaks.html.j2", b=_breaks_data(study, colors, caption, device))
+
+
+def _rules_values(study: "S.Study") -> dict[str, str]:
+    return {"fractions": "/".join(f"{f:g}" for f in study.fractions),
+            "ratio": f"{S.LEAK_RATIO:g}", "flip": f"{S.LEAK_FLIP:g}",
+            "share": f"{100 * S.LEAK_SHARE:g}", "e0": f"{S.ENERGY_BAND[0]:g}",
+            "e1": f"{S.ENERGY_BAND[1]:g}", "tf": f"{S.TEMPORAL_FACTOR:g}"}
 
 
 def rules_html(study: "S.Study") -> str:
-    return RULES_HTML.format(fractions="/".join(f"{f:g}" for f in study.fractions),
-                             ratio=f"{S.LEAK_RATIO:g}", flip=f"{S.LEAK_FLIP:g}",
-                             share=f"{100 * S.LEAK_SHARE:g}", e0=f"{S.ENERGY_BAND[0]:g}",
-                             e1=f"{S.ENERGY_BAND[1]:g}", tf=f"{S.TEMPORAL_FACTOR:g}")
+    """The study's rules paragraph (templates/study_rules.html.j2)."""
+    return render("study_rules.html.j2", **_rules_values(study))
+
+
+def _floor_values(st: "S.SceneStudy") -> dict[str, str]:
+    """The numbers of a scene's "Direct floor" paragraph, formatted."""
+    floor = st.direct_floor
+    return {"flip": S.sig3(floor.y) if floor else "—", "ms": S.ms(floor.x) if floor else "—",
+            "light_flip": S.sig3(st.direct_light_flip),
+            "light_energy": S.sig3(st.direct_light_energy),
+            "light_leak": (S.sig3(100 * st.direct_light_leak)
+                           if st.direct_light_leak is not None else "—"),
+            "spp": ", ".join(f"{v:g}" for v in st.reference_spp) or "—",
+            "noise_floor": S.sig3(st.rel_mse_noise_floor),
+            "flip_floor": (S.sig3(st.flip_floor) if st.flip_floor is not None
+                           else "not recorded"),
+            "flip_noise": (S.sig3(st.flip_noise) if st.flip_noise is not None
+                           else "not recorded")}
+
+
+def _time_value(p: "S.Point") -> Markup:
+    return Markup("{} <small>({})</small>").format(S.sig3(p.y), S.ms(p.x))
+
+
+def _error_value(p: "S.Point") -> Markup:
+    return Markup("{} <small>({})</small>").format(S.ms(p.x), S.sig3(p.y))
 
 
 def study_section_html(study: "S.Study", colors: dict[str, str],
@@ -241,58 +249,30 @@ def study_section_html(study: "S.Study", colors: dict[str, str],
                        first: bool = True) -> str:
     """The report's cross-technique section (id="study" on the first device's block);
     figures: scene -> SVG path; figure_url: path -> relative URL; device_label: the time
-    headers' device words. '' when no scene has two measured series."""
+    headers' device words. '' when no scene has two measured series.
+    templates/study_section.html.j2."""
     shown = [sc for sc, st in study.scenes.items()
              if len({p.series for p in st.points if p.ranked}) >= 2]
     if not shown:
         return ""
-    caption = f"timed on {_e(study.device)}; machine {_e(study.machine)}"
-    head = ('<h2 id="study">Cross-technique study: every series along its ladder</h2>'
-            + rules_html(study)) if first else ""
-    parts = [head, f'<p class="device-line">Timed on {_e(study.device)}, machine '
-             f'{_e(study.machine)}.</p>']
+    caption = Markup("timed on {}; machine {}").format(study.device, study.machine)
+    scenes = []
     for scene, st in study.scenes.items():
         if scene not in shown:
             continue
         series = [s for s in study.series if s in st.series]
-        parts.append(f'<h3 class="study-scene">{_e(scene)}</h3>')
-        floor = st.direct_floor
-        if scene in S.NOT_QUALITY:
-            parts.append('<p class="warn">A leak test: the path tracer shows this view black, '
-                         "so every error below is light that leaked (see \"Where it breaks\"); "
-                         "it is left out of the findings' winners.</p>")
-        parts.append(
-            f'<p class="floor">Direct floor: HDR-FLIP {S.sig3(floor.y) if floor else "—"} vs '
-            f"the full reference ({S.ms(floor.x) if floor else '—'}). The shared direct light's "
-            f"own error (emission+direct vs the reference's, <code>metrics.direct</code>): "
-            f"HDR-FLIP {S.sig3(st.direct_light_flip)}, energy "
-            f"{S.sig3(st.direct_light_energy)}, shadow leak "
-            f"{S.sig3(100 * st.direct_light_leak) if st.direct_light_leak is not None else '—'}"
-            f" %. Reference {', '.join(f'{v:g}' for v in st.reference_spp) or '—'} spp; "
-            f"relMSE noise floor {S.sig3(st.rel_mse_noise_floor)}; HDR-FLIP noise floor "
-            f"{S.sig3(st.flip_floor) if st.flip_floor is not None else 'not recorded'}; "
-            f"HDR-FLIP error bar "
-            f"{S.sig3(st.flip_noise) if st.flip_noise is not None else 'not recorded'}.</p>")
-        if scene in figures:
-            url = figure_url(figures[scene])
-            parts.append(
-                f'<figure class="plot"><a href="{url}"><img src="{url}" alt="{_e(scene)}: '
-                f'error against frame time, every series" onerror="gilabImageError(this)"></a>'
-                f"<figcaption>Every series' runs joined by time; black dashed step and rings: "
-                f"the Pareto front across all series; diamonds: the paper's rung; dotted line: "
-                f"the direct floor. {caption}.</figcaption></figure>")
-        parts.append("<h4>Equal time: best HDR-FLIP vs full reference within each budget</h4>")
-        parts.append(_table(st.equal_time, series, colors, caption, "series",
-                            lambda p: f"{S.sig3(p.y)} <small>({S.ms(p.x)})</small>"))
-        parts.append(f"<h4>Equal error: least frame time ({_e(device_label)}) to reach each "
-                     "HDR-FLIP target</h4>")
-        parts.append(_table(st.equal_error, series, colors, caption, "series",
-                            lambda p: f"{S.ms(p.x)} <small>({S.sig3(p.y)})</small>")
-                     or "<p>No direct floor on this scene: no targets.</p>")
-    parts.append(cost_table_html(study, colors, device_label))
-    parts.append("<h3>Where it breaks</h3>")
-    parts.append(breaks_table(study, colors, caption, device_label))
-    return "".join(parts)
+        scenes.append({
+            "name": scene, "leak_test": scene in S.NOT_QUALITY, "floor": _floor_values(st),
+            "figure": figure_url(figures[scene]) if scene in figures else None,
+            "equal_time": _table_data(st.equal_time, series, colors, caption, "series",
+                                      _time_value),
+            "equal_error": _table_data(st.equal_error, series, colors, caption, "series",
+                                       _error_value)})
+    return render("study_section.html.j2", first=first,
+                  rules=Markup(rules_html(study)) if first else "", device=study.device,
+                  machine=study.machine, caption=caption, scenes=scenes,
+                  device_label=device_label, cost=_cost_data(study, colors, device_label),
+                  breaks=_breaks_data(study, colors, caption, device_label))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -452,7 +432,7 @@ def cost_head(device: str) -> list[str]:
     """The whole-cost table's headers; every time column names the device ('…, lavapipe
     (CPU), ms')."""
     timed = {c: f"{c}, {device}, ms" for c in TIMED_COST_COLUMNS}
-    return ["series", "rung", "scenes", timed["static frame"], "memory, MiB",
+    return ["series", "rung", "scenes", timed["static frame"], "memory, MiB (own)",
             timed["set-up cold"], timed["set-up cached"], timed["light moves"],
             timed["camera moves"], "payback, frames", timed["fixed"], timed["per Mpixel"],
             timed["at 1920x1080"]]
@@ -464,8 +444,9 @@ def cost_cells(c: "C.CostRow") -> list[str]:
     series = c.series + (" (CPU path tracer: its CPU clock)"
                          if c.series.partition(" (")[0] == S.PATH_TRACER else "")
     return [series, c.rung or "defaults", str(c.scenes) if c.scenes else "—", t(c.static_ms),
-            S.sig3(c.memory_mib), t(c.setup_ms), t(c.setup_cached_ms), t(c.light_ms),
-            t(c.camera_ms), S.sig3(c.payback_frames),
+            (f"{S.sig3(c.memory_mib)} ({S.sig3(c.own_memory_mib)})"
+             if c.memory_mib is not None else "—"), t(c.setup_ms), t(c.setup_cached_ms),
+            t(c.light_ms), t(c.camera_ms), S.sig3(c.payback_frames),
             S.sig3(c.split.fixed_ms) if c.split else "—",
             S.sig3(c.split.per_mpixel_ms) if c.split else "—", t(c.full_hd_ms)]
 
@@ -479,18 +460,19 @@ COST_NOTE = ("static frame: median over the quality scenes; light / camera moves
              "faster than the pixel count)")
 
 
-def cost_table_html(study: "S.Study", colors: dict[str, str], device: str) -> str:
+def _cost_data(study: "S.Study", colors: dict[str, str], device: str) -> Optional[dict]:
+    """study_cost.html.j2's c (None without rows)."""
     rows = C.whole_cost(study)
     if not rows:
-        return ""
-    body = "".join("<tr>" + "".join(
-        f"<td>{_sw(v, colors) if i == 0 else _e(v)}</td>" for i, v in enumerate(cost_cells(c)))
-        + "</tr>" for c in rows)
-    head = "".join(f"<th>{_e(h)}</th>" for h in cost_head(device))
-    return (f'<h3 id="whole-cost">Whole cost</h3><table class="data study cost"><caption '
-            f'class="device-line">timed on {_e(study.device)}; machine {_e(study.machine)}'
-            f"</caption><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
-            f'<p class="note">{_e(COST_NOTE)}</p>')
+        return None
+    cells = [cost_cells(c) for c in rows]
+    return {"device": study.device, "machine": study.machine, "heads": cost_head(device),
+            "rows": [(Markup(_sw(v[0], colors)), v[1:]) for v in cells], "note": COST_NOTE}
+
+
+def cost_table_html(study: "S.Study", colors: dict[str, str], device: str) -> str:
+    c = _cost_data(study, colors, device)
+    return render("study_cost.html.j2", c=c) if c else ""
 
 
 def _short_device(device: str) -> str:
