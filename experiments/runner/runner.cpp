@@ -395,6 +395,52 @@ void beginResult(Context& c, nlohmann::ordered_json& result, const RunSpec& run,
                        {"resolution", {scene.settings.width, scene.settings.height}}};
 }
 
+/** The tone map of a run's previews and LDR metrics: the scene's exposure plus the config's. */
+ToneMap runToneMap(const Context& c, const Scene& scene) {
+    ToneMap tm;
+    tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
+    return tm;
+}
+
+/** The run's timed frames: its block's "frames", else the config's. */
+int timedFrames(const Context& c, const RunSpec& run) {
+    return run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
+}
+
+/** result["reference"]: the reference the run is compared with, and its preview. */
+void addReferenceBlock(Context& c, nlohmann::ordered_json& result, const RunSpec& run,
+                       const ReferenceSet& refs, const MatchedReference& matched,
+                       const ToneMap& tm) {
+    result["reference"] = {{"key", refs.result().key},
+                           {"samples", refs.result().acc.samples},
+                           {"rel_error", ref::meanRelativeStdError(refs.result().acc)},
+                           {"matched", matched.name}};
+    result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
+}
+
+/**
+ * The static frame's metrics against the references (matched, full, bounce ladder, direct
+ * light, bounce floors), its EXR and PNG files and result["outputs"].
+ */
+void addStaticMetricsAndOutputs(Context& c, nlohmann::ordered_json& result,
+                                const std::vector<ImageLayer>& layers, const ReferenceSet& refs,
+                                const MatchedReference& matched, int bounces, const ToneMap& tm,
+                                const fs::path& tmp) {
+    result["metrics"] = computeRunMetrics(layers, matched, bounces, c.config.metrics, tm, tmp);
+    result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
+    result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
+    result["metrics"]["bounce_floors"] = computeBounceFloors(refs, c.config.metrics, tm);
+    writeExrWithMainImage((tmp / "output.exr").string(), layers, "final",
+                          {{kPixelFilterAttribute, "center"}});
+    writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
+    writePngTonemapped((tmp / "indirect.png").string(), layers[1].image, tm);
+    result["outputs"] = {{"exr", "output.exr"},
+                         {"final_png", "final.png"},
+                         {"indirect_png", "indirect.png"},
+                         {"flip_png", "flip.png"},
+                         {"flip_full_png", "flip_full.png"}};
+}
+
 /**
  * The equal-time path-tracer baseline (pt_baseline.h): the reference renderer at `spp` samples
  * per pixel on this CPU, compared with the same references and metrics as any technique. It
@@ -430,39 +476,19 @@ std::string executePathTracerRun(Context& c, const RunSpec& run, const std::stri
     }
     const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
     const MatchedReference matched = refs.match(kAllBounces);
-    ToneMap tm;
-    tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
-    result["reference"] = {{"key", refs.result().key},
-                           {"samples", refs.result().acc.samples},
-                           {"rel_error", ref::meanRelativeStdError(refs.result().acc)},
-                           {"matched", matched.name}};
-    result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
+    const ToneMap tm = runToneMap(c, scene);
+    addReferenceBlock(c, result, run, refs, matched, tm);
     std::fprintf(stderr, "[gilab] run %zu/%zu %s on %s (spp %d)\n", position, count, kPathTracerId,
                  run.scene->label.c_str(), run.params.getInt("spp"));
-    const int timed = run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
-    PtBaselineOutput pt = renderPtBaseline(
-        scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
-        uint64_t(run.params.getInt("seed")), c.config.timing.warmupFrames, timed, c.cancel);
+    PtBaselineOutput pt =
+        renderPtBaseline(scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
+                         uint64_t(run.params.getInt("seed")), c.config.timing.warmupFrames,
+                         timedFrames(c, run), c.cancel);
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(pt.layers, &nonFinite);
     result["timing"] = pt.timing;
     result["stats"] = pt.stats;
-    result["metrics"] =
-        computeRunMetrics(pt.layers, matched, kAllBounces, c.config.metrics, tm, tmp);
-    result["metrics"]["final_vs_bounces"] =
-        computeBounceLadder(pt.layers, refs, c.config.metrics, tm);
-    result["metrics"]["direct"] =
-        computeDirectMetrics(pt.layers, refs.match(0), c.config.metrics, tm);
-    result["metrics"]["bounce_floors"] = computeBounceFloors(refs, c.config.metrics, tm);
-    writeExrWithMainImage((tmp / "output.exr").string(), pt.layers, "final",
-                          {{kPixelFilterAttribute, "center"}});
-    writePngTonemapped((tmp / "final.png").string(), pt.layers[0].image, tm);
-    writePngTonemapped((tmp / "indirect.png").string(), pt.layers[1].image, tm);
-    result["outputs"] = {{"exr", "output.exr"},
-                         {"final_png", "final.png"},
-                         {"indirect_png", "indirect.png"},
-                         {"flip_png", "flip.png"},
-                         {"flip_full_png", "flip_full.png"}};
+    addStaticMetricsAndOutputs(c, result, pt.layers, refs, matched, kAllBounces, tm, tmp);
     return commitResult(c, result, tmp, key, {.supported = true, .nonFinitePixels = nonFinite});
 }
 
@@ -501,15 +527,10 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
 
     const ReferenceSet& refs = referenceFor(c, *run.scene, scene);
     const MatchedReference matched = refs.match(claimedBounces(info, run.params));
-    ToneMap tm;
-    tm.exposureEv = scene.settings.exposureEv + c.config.metrics.exposureEv;
-    result["reference"] = {{"key", refs.result().key},
-                           {"samples", refs.result().acc.samples},
-                           {"rel_error", ref::meanRelativeStdError(refs.result().acc)},
-                           {"matched", matched.name}};
-    result["reference"].update(writeReferencePreview(c, *run.scene, matched, tm));
+    const ToneMap tm = runToneMap(c, scene);
+    addReferenceBlock(c, result, run, refs, matched, tm);
 
-    const int timed = run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
+    const int timed = timedFrames(c, run);
     Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
                           info.id + " on " + run.scene->label,
                       size_t(c.config.timing.warmupFrames + timed));
@@ -587,22 +608,9 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     for (const auto& [name, value] : harness->stats())
         result["stats"][name] = value;
     harness.reset();
-    result["metrics"] = computeRunMetrics(layers, matched, claimedBounces(info, run.params),
-                                          c.config.metrics, tm, tmp);
-    result["metrics"]["final_vs_bounces"] = computeBounceLadder(layers, refs, c.config.metrics, tm);
-    result["metrics"]["direct"] = computeDirectMetrics(layers, refs.match(0), c.config.metrics, tm);
-    result["metrics"]["bounce_floors"] = computeBounceFloors(refs, c.config.metrics, tm);
+    addStaticMetricsAndOutputs(c, result, layers, refs, matched, claimedBounces(info, run.params),
+                               tm, tmp);
     if (!sameVpl.is_null()) result["metrics"]["same_vpl"] = sameVpl;
-
-    writeExrWithMainImage((tmp / "output.exr").string(), layers, "final",
-                          {{kPixelFilterAttribute, "center"}});
-    writePngTonemapped((tmp / "final.png").string(), layers[0].image, tm);
-    writePngTonemapped((tmp / "indirect.png").string(), layers[1].image, tm);
-    result["outputs"] = {{"exr", "output.exr"},
-                         {"final_png", "final.png"},
-                         {"indirect_png", "indirect.png"},
-                         {"flip_png", "flip.png"},
-                         {"flip_full_png", "flip_full.png"}};
     if (sequence) {
         result["metrics"]["sequence"] = sequence->metrics;
         result["outputs"]["frames_png"] = sequence->framePngs;
