@@ -1,17 +1,24 @@
-# gilab_add_shaders(<target> BASE <dir> SOURCES <glsl files relative to BASE>...)
+# gilab_add_shaders(<target> BASE <dir> [PREFIX <name prefix>] SOURCES <glsl stages>...)
 #
-# Compiles each GLSL stage to SPIR-V with glslangValidator at build time (with #include support
-# from shaders/ and a depfile so edits to included files rebuild), embeds the words in a generated
-# C++ file and registers them under the name "<path relative to shaders/>", e.g.
-# "common/direct_light.comp". Shaders are looked up by that name at run time (core/vk/shader.h).
+# Compiles each GLSL stage to SPIR-V with glslangValidator at build time, embeds the words in a
+# generated C++ file and registers them under "<PREFIX><path relative to BASE>", e.g.
+# "common/direct_light.comp" (BASE shaders/) or "cvgi/final_frame.comp" (BASE
+# techniques/cvgi/shaders, PREFIX cvgi/). Shaders are looked up by that name at run time
+# (core/vk/shader.h). `#include "x.glsl"` is searched beside the including file first, then in
+# GILAB_SHADER_INCLUDE_DIR (the shared shaders: shaders/ in the tree, share/gilab/shaders when
+# installed), so `#include "common/brdf.glsl"` works in and out of the tree. A depfile makes edits
+# to included files rebuild.
 function(gilab_add_shaders target)
-    cmake_parse_arguments(ARG "" "" "SOURCES" ${ARGN})
-    set(shader_root ${CMAKE_SOURCE_DIR}/shaders)
+    cmake_parse_arguments(ARG "" "BASE;PREFIX" "SOURCES" ${ARGN})
+    if(NOT ARG_BASE)
+        set(ARG_BASE ${GILAB_SHADER_INCLUDE_DIR})
+    endif()
     set(out_dir ${CMAKE_BINARY_DIR}/spirv)
     set(generated "")
     foreach(src ${ARG_SOURCES})
-        get_filename_component(abs ${src} ABSOLUTE BASE_DIR ${CMAKE_SOURCE_DIR})
-        file(RELATIVE_PATH rel ${shader_root} ${abs})
+        get_filename_component(abs ${src} ABSOLUTE BASE_DIR ${ARG_BASE})
+        file(RELATIVE_PATH rel ${ARG_BASE} ${abs})
+        set(rel "${ARG_PREFIX}${rel}")
         string(MAKE_C_IDENTIFIER "kSpv_${rel}" var)
         set(header ${out_dir}/${rel}.h)
         set(cpp ${out_dir}/${rel}.cpp)
@@ -19,7 +26,7 @@ function(gilab_add_shaders target)
         file(MAKE_DIRECTORY ${header_dir})
         add_custom_command(
             OUTPUT ${header}
-            COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.3 -I${shader_root}
+            COMMAND ${GLSLANG_VALIDATOR} --quiet --target-env vulkan1.3 -I${GILAB_SHADER_INCLUDE_DIR}
                     --vn ${var} --depfile ${header}.d -o ${header} ${abs}
             DEPENDS ${abs}
             DEPFILE ${header}.d

@@ -11,6 +11,7 @@
 
 #include "core/technique/frame_harness.h"
 #include "core/technique/registry.h"
+#include "core/util/embedded_text.h"
 #include "core/util/error.h"
 #include "experiments/audit/audit.h"
 #include "experiments/audit/child_process.h"
@@ -97,6 +98,59 @@ TEST(CpuAudit, DocumentedFailureTurnsAnEnergyExcessAmberButNotANaN) {
     c.nanPixels = 2;
     gradeCell(c, leak);
     EXPECT_EQ(c.grade, Grade::Red);
+}
+
+// Two techniques' declarations, embedded as gilab_add_technique embeds known_weaknesses.json.
+const EmbeddedTextRegistration kDeclared{
+    "declaring/known_weaknesses.json",
+    R"({"comment": "test", "cases": {"stiff": "constant term, ignores the lights"}})"};
+const EmbeddedTextRegistration kMalformed{"malformed/known_weaknesses.json",
+                                          R"({"cases": {"stiff": ""}})"};
+
+TEST(CpuAudit, DeclaredWeaknessTurnsAMeasuredRedIntoDeclaredButNeverADefect) {
+    AuditCase stiff;
+    stiff.name = "stiff";
+    CellResult c = okCell();
+    c.technique = "declaring";
+    c.energyRatio = 40.0;  // a blow-up: red unless declared
+    gradeCell(c, stiff);
+    EXPECT_EQ(c.grade, Grade::Declared) << c.reason;
+    EXPECT_EQ(c.declared, "constant term, ignores the lights");
+    EXPECT_NE(c.reason.find("40"), std::string::npos) << c.reason;  // the number stays
+
+    AuditCase other;
+    other.name = "other";  // a case it does not declare
+    c.declared.clear();
+    gradeCell(c, other);
+    EXPECT_EQ(c.grade, Grade::Red);
+
+    c.technique = "vct";  // declares nothing
+    gradeCell(c, stiff);
+    EXPECT_EQ(c.grade, Grade::Red);
+
+    c.technique = "declaring";  // a defect in a declared case stays red
+    for (auto defect : std::vector<void (*)(CellResult&)>{
+             [](CellResult& x) { x.nanPixels = 1; },
+             [](CellResult& x) { x.validationMessages = 1; },
+             [](CellResult& x) { x.outcome = "crash"; },
+             [](CellResult& x) { x.outcome = "error", x.message = "boom"; }}) {
+        CellResult d = c;
+        defect(d);
+        gradeCell(d, stiff);
+        EXPECT_EQ(d.grade, Grade::Red) << d.reason;
+    }
+}
+
+TEST(CpuAudit, MalformedDeclarationNamesTheFile) {
+    try {
+        declaredWeaknesses("malformed");
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("malformed/known_weaknesses.json"), std::string::npos)
+            << e.what();
+        EXPECT_NE(std::string(e.what()).find("stiff"), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(declaredWeaknesses("vct").empty());
 }
 
 TEST(CpuAudit, RefusalIsGreenOnlyWhenItNamesTheParameter) {

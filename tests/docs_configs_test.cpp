@@ -1,7 +1,9 @@
 // Every experiment config shown in the documentation validates (issue 10): the ```json blocks
-// of README.md and docs/*.md (each is JSON, or a "key": value fragment) that hold a "techniques"
-// key, with the page's // comments removed, parsed relative to experiments/configs/ (where the
-// docs' relative scene paths point from).
+// of README.md, docs/*.md and each technique's page techniques/<id>/README.md (each is JSON, or
+// a "key": value fragment) that hold a "techniques" key, with the page's // comments removed,
+// parsed relative to experiments/configs/ (where the docs' relative scene paths point from).
+// And every config file, in experiments/configs/ and in each technique's configs/, validates
+// relative to its own folder (issue 45: configs moved into technique folders keep their scenes).
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -51,6 +53,8 @@ TEST(CpuDocs, EveryConfigShownInTheDocsValidates) {
     std::vector<fs::path> pages{root / "README.md"};
     for (const auto& e : fs::directory_iterator(root / "docs"))
         if (e.path().extension() == ".md") pages.push_back(e.path());
+    for (const auto& e : fs::directory_iterator(root / "techniques"))
+        if (fs::exists(e.path() / "README.md")) pages.push_back(e.path() / "README.md");
     int configs = 0;
     for (const fs::path& page : pages) {
         for (const Block& b : jsonBlocks(page)) {
@@ -79,6 +83,30 @@ TEST(CpuDocs, EveryConfigShownInTheDocsValidates) {
         }
     }
     EXPECT_GE(configs, 1) << "no config found in the docs: is the test still looking?";
+}
+
+TEST(CpuDocs, EveryConfigFileValidatesFromItsFolder) {
+    const fs::path root(GILAB_SOURCE_DIR);
+    std::vector<fs::path> folders{root / "experiments" / "configs"};
+    for (const auto& e : fs::directory_iterator(root / "techniques"))
+        if (fs::is_directory(e.path() / "configs")) folders.push_back(e.path() / "configs");
+    int files = 0;
+    for (const fs::path& folder : folders) {
+        for (const auto& e : fs::directory_iterator(folder)) {
+            if (e.path().extension() != ".json" || e.path().filename() == "audit.json") continue;
+            ++files;
+            try {
+                const exp::ExperimentConfig config = exp::loadExperimentConfig(e.path().string());
+                EXPECT_FALSE(exp::expandRuns(config).empty()) << e.path();
+                for (const exp::SceneEntry& scene : config.scenes)
+                    if (!scene.path.empty())
+                        EXPECT_TRUE(fs::exists(scene.path)) << e.path() << ": " << scene.path;
+            } catch (const Error& err) {
+                ADD_FAILURE() << e.path() << ": " << err.what();
+            }
+        }
+    }
+    EXPECT_GE(files, 10);
 }
 
 }  // namespace

@@ -92,7 +92,7 @@ TEST_F(GpuSelfGather, LitFloorGathersNoLightFromItself) {
 }
 
 TEST_F(GpuSelfGather, OctreeWithTheDenseLiftGathersALittle) {
-    // The octree's extra lift (docs/techniques/vct_svo.md "Lift"): with the dense clearance
+    // The octree's extra lift (techniques/vct/svo.md "Lift"): with the dense clearance
     // (octree_lift_extra 0) the floor's own cells reach the lifted samples' footprint.
     const FloorGather g = floorGather(
         *m_ctx, "vct",

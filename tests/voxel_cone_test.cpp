@@ -707,8 +707,8 @@ TEST_F(GpuVoxelCone, LiftKeepsASurfaceOutOfItsOwnCones) {
     EXPECT_GT(r[1].r, 0.01f);
 }
 
-// A measured limit of marching trilinearly filtered voxels (issue 43 item 1, docs/techniques/
-// vct.md "Energy against the grid resolution"): a ray of aperture 0 through an opaque shell one
+// A measured limit of marching trilinearly filtered voxels (issue 43 item 1, techniques/vct/
+// README.md "Energy against the grid resolution"): a ray of aperture 0 through an opaque shell one
 // voxel thick samples the shell's opacity as a tent two voxels wide, and with the step
 // correction the tent's optical depth is finite: at normal incidence 16-19 % of what lies behind
 // passes (the shell gives 0.81-0.84 of its radiance) unless a sample lands on a voxel centre;

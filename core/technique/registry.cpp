@@ -13,16 +13,17 @@ TechniqueRegistry& TechniqueRegistry::instance() {
 
 void TechniqueRegistry::add(TechniqueInfo info, Factory factory) {
     if (find(info.id)) {
-        m_duplicates.push_back(info.id);
+        m_duplicates.push_back(info.id + " (" + origin(info.id) + " and " +
+                               (m_origin.empty() ? std::string("built in") : m_origin) + ")");
         return;
     }
-    m_entries.push_back({std::move(info), std::move(factory)});
+    m_entries.push_back({std::move(info), std::move(factory), m_origin});
 }
 
 std::vector<const TechniqueInfo*> TechniqueRegistry::list() const {
     if (!m_duplicates.empty())
         throw Error("technique id registered twice: " + m_duplicates.front() +
-                    " (each techniques/<id>/ folder must have a unique id)");
+                    " (each technique folder or module must have a unique id)");
     std::vector<const TechniqueInfo*> out;
     for (const Entry& e : m_entries)
         out.push_back(&e.info);
@@ -53,6 +54,16 @@ std::unique_ptr<Technique> TechniqueRegistry::create(const std::string& id) cons
         return technique;
     }
     return nullptr;
+}
+
+std::string TechniqueRegistry::origin(const std::string& id) const {
+    for (const Entry& e : m_entries)
+        if (e.info.id == id) return e.origin.empty() ? "built in" : e.origin;
+    return {};
+}
+
+void TechniqueRegistry::removeOrigin(const std::string& origin) {
+    std::erase_if(m_entries, [&](const Entry& e) { return e.origin == origin; });
 }
 
 ParamSet TechniqueRegistry::defaultParams(const std::string& id) const {

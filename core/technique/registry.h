@@ -30,14 +30,24 @@ public:
     std::unique_ptr<Technique> create(const std::string& id) const;
     /** Default parameters of a technique, validated against its spec table. */
     ParamSet defaultParams(const std::string& id) const;
+    /** Where a technique comes from: "built in", or the path of the module that registered it
+     *  (core/technique/modules.h). */
+    std::string origin(const std::string& id) const;
+
+    /** The origin given to registrations from now on (empty: built in); set around dlopen. */
+    void setOrigin(std::string origin) { m_origin = std::move(origin); }
+    /** Forgets every technique registered from `origin` (a module that was refused). */
+    void removeOrigin(const std::string& origin);
 
 private:
     struct Entry {
         TechniqueInfo info;
         Factory factory;
+        std::string origin;
     };
     std::vector<Entry> m_entries;
     std::vector<std::string> m_duplicates;
+    std::string m_origin;
 };
 
 struct TechniqueRegistrar {

@@ -69,7 +69,11 @@ struct Catalog {
 /** Reads the catalog strictly (unknown keys, bad values: gilab::Error naming file and key). */
 Catalog loadCatalog(const std::string& path);
 
-enum class Grade { NotApplicable, Skipped, Green, Amber, Red };
+/** Declared: a cell that would be red for a measured weakness (an energy or peak blow-up, a
+ *  scale dependence) which the technique declares in its folder's known_weaknesses.json
+ *  (docs/audit.md, "Declared weaknesses"); defects (crashes, non-finite pixels, validation
+ *  messages, unexplained errors) are never declared. */
+enum class Grade { NotApplicable, Skipped, Green, Amber, Declared, Red };
 const char* gradeName(Grade g);
 
 /** What one technique x case produced (a subset is set, depending on how far it got). */
@@ -95,8 +99,14 @@ struct CellResult {
     double peakMemoryMiB = 0.0;
     std::string runDir;  // the committed run folder
     Grade grade = Grade::NotApplicable;
-    std::string reason;  // the number behind the grade
+    std::string reason;    // the number behind the grade
+    std::string declared;  // the technique's own reason, when the grade is Declared
 };
+
+/** The audit cases a technique declares it fails, case name -> why, from the text embedded as
+ *  "<id>/known_weaknesses.json" (cmake/GilabTechnique.cmake); empty when it declares none.
+ *  Throws gilab::Error naming the file on a malformed declaration. */
+std::map<std::string, std::string> declaredWeaknesses(const std::string& technique);
 
 /** The path tracer's checks of one case's reference. */
 struct ReferenceResult {
@@ -149,7 +159,7 @@ struct AuditOptions {
 struct AuditSummary {
     std::vector<CellResult> cells;
     std::vector<ReferenceResult> references;
-    size_t green = 0, amber = 0, red = 0;
+    size_t green = 0, amber = 0, declared = 0, red = 0;
     bool cancelled = false;
 };
 

@@ -19,6 +19,8 @@ const char* gradeName(Grade g) {
             return "green";
         case Grade::Amber:
             return "amber";
+        case Grade::Declared:
+            return "declared";
         case Grade::Red:
             return "red";
     }
@@ -33,12 +35,14 @@ std::string fmt(const char* format, double v) {
     return buf;
 }
 
-/** Keeps the worst grade; its reason first. */
+/** Keeps the worst grade; its reason first. `defect` marks a red that no declaration excuses. */
 struct Verdict {
     Grade grade = Grade::Green;
     std::string reasons;
-    void add(Grade g, const std::string& why) {
+    bool defect = false;
+    void add(Grade g, const std::string& why, bool isDefect = false) {
         if (g == Grade::Green) return;
+        defect = defect || (g == Grade::Red && isDefect);
         if (g > grade) {
             grade = g;
             reasons = why + (reasons.empty() ? "" : "; " + reasons);
@@ -69,7 +73,7 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
         cell.reason = "unsupported: " + cell.message;
         return;
     }
-    if (cell.outcome == "crash") v.add(Grade::Red, "crashed: " + cell.message);
+    if (cell.outcome == "crash") v.add(Grade::Red, "crashed: " + cell.message, true);
     if (cell.outcome == "timeout") v.add(Grade::Amber, "timed out: " + cell.message);
     if (cell.outcome == "refused") {
         // A parameter case whose value is outside the declared range: a clear refusal that
@@ -84,19 +88,21 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
             cell.reason = "refused: " + cell.message;
             return;
         }
-        v.add(Grade::Red, "refused without naming the parameter: " + cell.message);
+        v.add(Grade::Red, "refused without naming the parameter: " + cell.message, true);
     }
     if (cell.outcome == "error")
         v.add(isMemoryError(cell.message) ? Grade::Amber : Grade::Red,
               std::string(isMemoryError(cell.message) ? "out of memory (reported): " : "failed: ") +
-                  cell.message);
+                  cell.message,
+              true);
     const size_t bad = cell.nanPixels + cell.infPixels + cell.negativePixels;
     if (bad > 0)
-        v.add(Grade::Red, std::to_string(cell.nanPixels) + " NaN, " +
-                              std::to_string(cell.infPixels) + " Inf, " +
-                              std::to_string(cell.negativePixels) + " negative pixels");
+        v.add(Grade::Red,
+              std::to_string(cell.nanPixels) + " NaN, " + std::to_string(cell.infPixels) +
+                  " Inf, " + std::to_string(cell.negativePixels) + " negative pixels",
+              true);
     if (cell.validationMessages > 0)
-        v.add(Grade::Red, std::to_string(cell.validationMessages) + " validation messages");
+        v.add(Grade::Red, std::to_string(cell.validationMessages) + " validation messages", true);
     if (cell.energyRatio) {
         const double e = *cell.energyRatio;
         if (std::isfinite(e) && e > t.energyRed && !c.documentedFailure.empty())
@@ -136,6 +142,14 @@ void gradeCell(CellResult& cell, const AuditCase& c, const Thresholds& t) {
     }
     cell.grade = v.grade;
     cell.reason = v.reasons;
+    if (v.grade == Grade::Red && !v.defect) {
+        const std::map<std::string, std::string> declared = declaredWeaknesses(cell.technique);
+        if (auto it = declared.find(c.name); it != declared.end()) {
+            cell.grade = Grade::Declared;
+            cell.declared = it->second;
+            cell.reason += "; declared by the technique: " + it->second;
+        }
+    }
     if (cell.reason.empty() && cell.leak)
         cell.reason = fmt("leak %.3g %% of the lit view's mean", 100.0 * *cell.leak);
     else if (cell.reason.empty() && cell.energyRatio)

@@ -90,6 +90,8 @@ const char* colour(Grade g) {
             return "#b7e1b0";
         case Grade::Amber:
             return "#f6d08a";
+        case Grade::Declared:
+            return "#d9c2e6";
         case Grade::Red:
             return "#f19a9a";
         default:
@@ -105,6 +107,7 @@ Json auditJson(const AuditSummary& s, const AuditOptions& o, const Catalog& cata
         cells.push_back({{"case", c.caseName},
                          {"technique", c.technique},
                          {"grade", gradeName(c.grade)},
+                         {"declared", c.declared},
                          {"reason", c.reason},
                          {"outcome", c.outcome},
                          {"message", c.message},
@@ -159,7 +162,8 @@ Json auditJson(const AuditSummary& s, const AuditOptions& o, const Catalog& cata
               {"validation", o.validation}}},
             {"catalog", catalog.path},
             {"provenance", cli::provenanceJson(o.commandLine)},
-            {"counts", {{"green", s.green}, {"amber", s.amber}, {"red", s.red}}},
+            {"counts",
+             {{"green", s.green}, {"amber", s.amber}, {"declared", s.declared}, {"red", s.red}}},
             {"cases", cases},
             {"references", refs},
             {"cells", cells}};
@@ -187,7 +191,7 @@ std::string auditMarkdown(const AuditSummary& s, const std::vector<std::string>&
             md += "- " + r.caseName + " / path tracer: " + gradeName(r.grade) + ", " + r.reason +
                   "\n";
     for (const CellResult& c : s.cells)
-        if (c.grade == Grade::Amber || c.grade == Grade::Red)
+        if (c.grade == Grade::Amber || c.grade == Grade::Declared || c.grade == Grade::Red)
             md += "- " + c.caseName + " / " + c.technique + ": " + gradeName(c.grade) + ", " +
                   c.reason + "\n";
     return md;
@@ -195,15 +199,16 @@ std::string auditMarkdown(const AuditSummary& s, const std::vector<std::string>&
 
 std::string auditHtml(const AuditSummary& s, const std::vector<std::string>& techniques,
                       const std::string& title) {
-    std::string h = "<!doctype html><html><head><meta charset=\"utf-8\"><title>" +
-                    htmlEscape(title) +
-                    "</title><style>body{font-family:sans-serif}table{border-collapse:collapse}"
-                    "td,th{border:1px solid #999;padding:3px 6px;font-size:13px}</style></head>"
-                    "<body><h1>" +
-                    htmlEscape(title) + "</h1><p>" + std::to_string(s.green) + " green, " +
-                    std::to_string(s.amber) + " amber, " + std::to_string(s.red) +
-                    " red. Hover a cell for its numbers; docs/audit.md explains the colours."
-                    "</p><table><tr><th>case</th><th>path tracer</th>";
+    std::string h =
+        "<!doctype html><html><head><meta charset=\"utf-8\"><title>" + htmlEscape(title) +
+        "</title><style>body{font-family:sans-serif}table{border-collapse:collapse}"
+        "td,th{border:1px solid #999;padding:3px 6px;font-size:13px}</style></head>"
+        "<body><h1>" +
+        htmlEscape(title) + "</h1><p>" + std::to_string(s.green) + " green, " +
+        std::to_string(s.amber) + " amber, " + std::to_string(s.declared) +
+        " declared (weaknesses the technique states in its folder), " + std::to_string(s.red) +
+        " red. Hover a cell for its numbers; docs/audit.md explains the colours."
+        "</p><table><tr><th>case</th><th>path tracer</th>";
     for (const std::string& t : techniques)
         h += "<th>" + htmlEscape(t) + "</th>";
     h += "</tr>";

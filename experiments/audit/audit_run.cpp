@@ -165,6 +165,7 @@ AuditSummary runAudit(const AuditOptions& o) {
     for (const CellResult& c : s.cells) {
         s.green += c.grade == Grade::Green;
         s.amber += c.grade == Grade::Amber;
+        s.declared += c.grade == Grade::Declared;
         s.red += c.grade == Grade::Red;
     }
     for (const ReferenceResult& r : s.references) {

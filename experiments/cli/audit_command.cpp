@@ -16,9 +16,9 @@ int runAuditCommand(audit::AuditOptions options) {
     if (!options.cancel) options.cancel = &interrupt.flag();
     const audit::AuditSummary s = audit::runAudit(options);
     std::printf(
-        "audit: %zu green, %zu amber, %zu red%s\n  table: %s/audit.md, %s/audit.html, "
-        "every number: %s/audit.json\n",
-        s.green, s.amber, s.red, s.cancelled ? " (interrupted: partial table)" : "",
+        "audit: %zu green, %zu amber, %zu declared, %zu red%s\n  table: %s/audit.md, "
+        "%s/audit.html, every number: %s/audit.json\n",
+        s.green, s.amber, s.declared, s.red, s.cancelled ? " (interrupted: partial table)" : "",
         options.outDir.c_str(), options.outDir.c_str(), options.outDir.c_str());
     if (s.cancelled || interrupt.interrupted()) return kExitInterrupted;
     return s.red > 0 ? kExitAuditRed : kExitOk;

@@ -1,6 +1,6 @@
 // `gilab bench light-power`: each punctual light's emitted, incident and reflected power traced
 // with Embree (reference/light_power.h), the control for the power a voxel volume holds
-// (docs/techniques/vct.md, "Energy against the grid resolution").
+// (techniques/vct/README.md, "Energy against the grid resolution").
 #include <cstdio>
 #include <vector>
 

@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "core/technique/modules.h"
 #include "core/technique/registry.h"
 #include "core/util/atomic_file.h"
 #include "core/util/build_info.h"
@@ -96,6 +97,20 @@ bool printSuggestion(const CLI::App& app, int argc, char** argv) {
     return false;
 }
 
+/** Loads the technique modules and passes --technique-dir on to child gilab processes (the audit,
+ *  slurm) through GILAB_TECHNIQUE_PATH. */
+void loadModules(const std::vector<std::string>& dirs) {
+    if (!dirs.empty()) {
+        std::string path;
+        for (const std::string& d : dirs)
+            path += (path.empty() ? "" : ":") + std::filesystem::absolute(d).string();
+        if (const char* old = std::getenv("GILAB_TECHNIQUE_PATH"); old && *old)
+            path += std::string(":") + old;
+        ::setenv("GILAB_TECHNIQUE_PATH", path.c_str(), 1);
+    }
+    loadTechniqueModules(moduleSearch({}));
+}
+
 }  // namespace
 
 void checkTechniqueName(const std::string& id) {
@@ -142,6 +157,13 @@ int runMain(int argc, char** argv) {
     std::string commandLine;
     for (int i = 0; i < argc; ++i)
         commandLine += (i ? " " : "") + std::string(argv[i]);
+
+    // Technique modules (core/technique/modules.h): loaded after parsing, before any command.
+    std::vector<std::string> techniqueDirs;
+    app.add_option("--technique-dir", techniqueDirs,
+                   "Load technique modules (gilab-technique-<id>.so) from this folder or file; "
+                   "repeatable. Also searched: GILAB_TECHNIQUE_PATH (':'-separated) and "
+                   "<binary dir>/../lib/gilab/techniques (docs/architecture.md)");
 
     bool listJson = false;
     CLI::App* list = app.add_subcommand("list", "List techniques and their parameters");
@@ -493,6 +515,7 @@ int runMain(int argc, char** argv) {
     }
 
     try {
+        loadModules(techniqueDirs);
         if (*list) return runList(listJson);
         if (*devices) return runDevices(deviceFilter);
         if (*info) return runSceneInfo(infoScene, infoJson);

@@ -56,6 +56,7 @@ int runList(bool json) {
                                          {"citation", t->citation},
                                          {"indirect_bounces", t->indirectBounces},
                                          {"supports", supportText(t->supports)},
+                                         {"origin", TechniqueRegistry::instance().origin(t->id)},
                                          {"params", specsToJson(t->params)}});
         }
         out["shared"] = specsToJson(shared);
@@ -65,6 +66,7 @@ int runList(bool json) {
     for (const TechniqueInfo* t : techniques) {
         std::printf("%s — %s\n", t->id.c_str(), t->description.c_str());
         if (!t->citation.empty()) std::printf("  paper: %s\n", t->citation.c_str());
+        std::printf("  from: %s\n", TechniqueRegistry::instance().origin(t->id).c_str());
         std::printf("  indirect bounces: %s; lights: %s\n", bouncesText(t->indirectBounces),
                     supportText(t->supports).c_str());
         if (t->params.empty())

@@ -151,7 +151,7 @@ nlohmann::ordered_json computeSameVplReference(FrameHarness& harness, const Scen
         {"mean", meanOf(*indirect)},
         {"exact_mean", exactMean}};
     // Mean RGB radiance of the VPLs of each bounce, exact and unshadowed (per-bounce accounting:
-    // scripts/ssvp_tables.py sets them beside the path tracer's bounce layers).
+    // techniques/ssvp/ssvp_tables.py sets them beside the path tracer's bounce layers).
     out["by_bounce"] = byBounce;
     layers.push_back({"vpl_exact", exact});
     layers.push_back({"vpl_unshadowed", unshadowed});

@@ -1,4 +1,4 @@
-#include "techniques/cvgi/cvgi.h"
+#include "cvgi.h"
 
 #include <algorithm>
 #include <cmath>
@@ -13,9 +13,9 @@
 #include "core/vk/context.h"
 #include "core/voxel/voxel_compaction.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/cvgi/cvgi_gpu.h"
-#include "techniques/cvgi/cvgi_readback.h"
-#include "techniques/cvgi/cvgi_setup.h"
+#include "cvgi_gpu.h"
+#include "cvgi_readback.h"
+#include "cvgi_setup.h"
 
 namespace gilab {
 namespace {
@@ -112,7 +112,7 @@ void CvgiTechnique::setup(TechniqueContext& ctx) {
                 [&] { voxels = readCompactVoxels(grid, compaction, lists, fragmentCount); });
     voxelizer.reset();  // the fragments and heads are no longer needed
 
-    // §4.2-4.3 on the CPU (docs/techniques/cvgi.md "Where it runs").
+    // §4.2-4.3 on the CPU (techniques/cvgi/README.md "Where it runs").
     std::vector<uint8_t> axis;
     cvgi::Clusters clusters;
     cvgi::FaceVisibility visibility;

@@ -2,7 +2,7 @@
 /**
  * `cvgi`: clustered voxel real-time global illumination, A. Cosin Ayerbe and G. Patow, Computers &
  * Graphics 103 (2022), doi 10.1016/j.cag.2022.01.005. Extraction: notes 000;
- * docs/techniques/cvgi.md. One indirect diffuse bounce, static geometry, spot and directional
+ * techniques/cvgi/README.md. One indirect diffuse bounce, static geometry, spot and directional
  * emitters (each needs one distance map; point lights and emissive surfaces are not supported).
  *
  * Set-up (Table 1; GPU passes by submitTimed, CPU passes by timeCpu):
@@ -23,8 +23,8 @@
 #include <vector>
 
 #include "core/technique/technique.h"
-#include "techniques/cvgi/cvgi_settings.h"
-#include "techniques/cvgi/cvgi_setup.h"
+#include "cvgi_settings.h"
+#include "cvgi_setup.h"
 
 namespace gilab {
 

@@ -2,7 +2,7 @@
 /**
  * Form factors for cvgi's gather (Cosin Ayerbe & Patow 2022 §4.4, Fig. 5: "a differential area
  * form factor" between a voxel face and a cluster; the paper does not write it out, notes 000
- * §2.5 [R] and §8.6). Derivation and measured errors: docs/techniques/cvgi.md, "Face-to-cluster
+ * §2.5 [R] and §8.6). Derivation and measured errors: techniques/cvgi/README.md, "Face-to-cluster
  * form factor".
  *
  * diskFormFactor is what the gather uses (the GLSL side must mirror it exactly);

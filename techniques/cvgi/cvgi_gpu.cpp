@@ -1,4 +1,4 @@
-#include "techniques/cvgi/cvgi_gpu.h"
+#include "cvgi_gpu.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,8 @@
 namespace gilab {
 namespace {
 
-/** Mirrors CvgiVoxel / CvgiCluster / CvgiClusterLight in shaders/cvgi/cvgi_common.glsl. */
+/** Mirrors CvgiVoxel / CvgiCluster / CvgiClusterLight in techniques/cvgi/shaders/cvgi_common.glsl.
+ */
 struct GpuCvgiVoxel {
     glm::vec4 albedoAxis;
     glm::vec4 normalCluster;

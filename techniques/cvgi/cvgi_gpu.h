@@ -2,10 +2,10 @@
 /**
  * cvgi's GPU side after set-up (Cosin Ayerbe & Patow 2022 §4.4-4.5): the static buffers built by
  * the CPU set-up (voxels, clusters, per-face visibility lists), the per-emitter-update state and
- * the passes that read them (shaders/cvgi/). Table 2's passes, recorded by recordEmitterUpdate():
- *   dist_shadow_map       the emitter's distance map (one per spot / directional light)
- *   lit_cluster           lit voxels (18-point test + neighbour test), then per-cluster sums
- *   camera_visible_voxel  small camera distance map + 12-point test, the gather list
+ * the passes that read them (techniques/cvgi/shaders/). Table 2's passes, recorded by
+ * recordEmitterUpdate(): dist_shadow_map       the emitter's distance map (one per spot /
+ * directional light) lit_cluster           lit voxels (18-point test + neighbour test), then
+ * per-cluster sums camera_visible_voxel  small camera distance map + 12-point test, the gather list
  *   light_bounce          per-face gather from the visible lit clusters
  *   gaussian_filtering    the 5^3 renormalised Gaussian, twice
  * and recordFinalFrame() per frame (final_frame).
@@ -24,9 +24,9 @@
 #include "core/vk/pipeline.h"
 #include "core/vk/sampler.h"
 #include "core/voxel/voxel_grid.h"
-#include "techniques/cvgi/cvgi_settings.h"
-#include "techniques/cvgi/cvgi_setup.h"
-#include "techniques/cvgi/cvgi_voxels.h"
+#include "cvgi_settings.h"
+#include "cvgi_setup.h"
+#include "cvgi_voxels.h"
 
 namespace gilab {
 

@@ -1,4 +1,4 @@
-#include "techniques/cvgi/cvgi_readback.h"
+#include "cvgi_readback.h"
 
 #include <string>
 

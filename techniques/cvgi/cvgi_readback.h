@@ -3,7 +3,7 @@
 #include <cstdint>
 
 #include "core/voxel/voxel_grid.h"
-#include "techniques/cvgi/cvgi_voxels.h"
+#include "cvgi_voxels.h"
 
 namespace gilab {
 

@@ -1,4 +1,4 @@
-#include "techniques/cvgi/cvgi_settings.h"
+#include "cvgi_settings.h"
 
 #include <string>
 
@@ -51,8 +51,9 @@ std::vector<ParamSpec> cvgiParamSpecs() {
         intParam("gaussian_kernel", 5, 0, 9, "voxels",
                  "Gaussian kernel width, odd (paper 5; 3 evaluated); 0 or 1 = no filtering"),
         intParam("gaussian_passes", 2, 0, 4, "", "Gaussian passes (paper 2)"),
-        floatParam("gaussian_sigma_voxels", 1.0, 0.1, 8.0, "voxels",
-                   "Gaussian standard deviation (not given in the paper; docs/techniques/cvgi.md)"),
+        floatParam(
+            "gaussian_sigma_voxels", 1.0, 0.1, 8.0, "voxels",
+            "Gaussian standard deviation (not given in the paper; techniques/cvgi/README.md)"),
         boolParam("gaussian_visibility", true,
                   "ours: a neighbour's face enters the Gaussian only if the straight path between "
                   "the two faces' front cells crosses no occupied voxel (false = the paper's "

@@ -2,7 +2,7 @@
 /**
  * Parameters of `cvgi` (clustered voxel GI, Cosin Ayerbe & Patow 2022; notes 000) and their parsed
  * form. Defaults are the paper's (or its authors' code's, where the paper is silent); every choice
- * is listed in docs/techniques/cvgi.md.
+ * is listed in techniques/cvgi/README.md.
  */
 #include <cstdint>
 #include <vector>
@@ -18,7 +18,7 @@ struct CvgiSettings {
     uint32_t clusterIterations = 10;
     float clusterAngleDeg = 35.0f;
     uint32_t raysPerFace = 128;
-    // The ray pattern (docs/techniques/cvgi.md "seed"): every face's ray set rotated about its
+    // The ray pattern (techniques/cvgi/README.md "seed"): every face's ray set rotated about its
     // normal by cvgi::seedRotation(seed) turns; 0 = the unrotated rays, bit for bit.
     uint32_t seed = 0;
     uint32_t shadowMapSize = 8192;  // emitter distance map (authors' code)

@@ -1,4 +1,4 @@
-#include "techniques/cvgi/cvgi_setup.h"
+#include "cvgi_setup.h"
 
 #include <algorithm>
 #include <atomic>

@@ -4,7 +4,7 @@
  *   heuristicNormals()  the axis-aligned "heuristic normal" of each voxel (§4.2, Fig. 7)
  *   clusterVoxels()     Algorithm 1, a deterministic emulation of the GPU SLIC-like race
  *   faceVisibility()    per voxel face, the clusters seen by 3D Bresenham rays (§4.3)
- * Every choice the paper leaves open is listed in docs/techniques/cvgi.md ("Set-up on the CPU").
+ * Every choice the paper leaves open is listed in techniques/cvgi/README.md ("Set-up on the CPU").
  * Not reproduced (authors' code only, not in the paper): the cluster-merge pass and the voxel-face
  * penalty. Results are deterministic and independent of the TBB thread count.
  */
@@ -13,7 +13,7 @@
 
 #include <glm/glm.hpp>
 
-#include "techniques/cvgi/cvgi_voxels.h"
+#include "cvgi_voxels.h"
 
 namespace gilab::cvgi {
 

@@ -1,4 +1,4 @@
-#include "techniques/direct/direct.h"
+#include "direct.h"
 
 #include "core/technique/registry.h"
 

@@ -1,4 +1,4 @@
-#include "techniques/dvs/dvs.h"
+#include "dvs.h"
 
 #include <cstdio>
 #include <string>
@@ -10,8 +10,8 @@
 #include "core/util/error.h"
 #include "core/voxel/voxel_radiance.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/dvs/pixel_trace.h"
-#include "techniques/dvs/voxel_lighting.h"
+#include "pixel_trace.h"
+#include "voxel_lighting.h"
 
 namespace gilab {
 
@@ -33,7 +33,7 @@ TechniqueInfo DvsTechnique::describe() {
     info.checkParams = [](const ParamSet& p) { (void)dvsSettingsFrom(p); };
     // Emitters light the voxels through the shared emitter samples (direct light at the voxel,
     // the source of the first bounce); their raw emission is never gathered
-    // (docs/techniques/dvs.md).
+    // (techniques/dvs/README.md).
     info.supports.emissiveSurfaces = true;
     return info;
 }

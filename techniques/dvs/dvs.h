@@ -2,7 +2,7 @@
 /**
  * `dvs`: deferred voxel shading, J. Villegas, "Deferred Voxel Shading for Real-Time Global
  * Illumination" (CLEI 2016; the VCTRenderer write-up). Extraction: notes 003;
- * docs/techniques/dvs.md.
+ * techniques/dvs/README.md.
  *
  * Set-up (ctx.submitTimed):
  *   voxelize, voxel_resolve  shared Voxelizer (albedo, normal, emission volumes)
@@ -18,7 +18,7 @@
  * Per frame: "trace" (P1) over the shared G-buffer: diffuse cones (E14), specular cone,
  * AO (debug view "ao"), optional cone shadows for the direct layer (E13).
  *
- * Deviations (docs/techniques/dvs.md): HDR RGBA16F radiance, physically consistent 1/pi and no GI
+ * Deviations (techniques/dvs/README.md): HDR RGBA16F radiance, physically consistent 1/pi and no GI
  * strength, our light falloff (lights.glsl), voxel centres, emitters lit through the shared emitter
  * samples (their direct light on the voxels) and never gathered as raw emission.
  * Parameters: techniques/dvs/dvs_settings.cpp.
@@ -26,7 +26,7 @@
 #include <memory>
 
 #include "core/technique/technique.h"
-#include "techniques/dvs/dvs_settings.h"
+#include "dvs_settings.h"
 
 namespace gilab {
 

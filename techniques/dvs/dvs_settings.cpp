@@ -1,4 +1,4 @@
-#include "techniques/dvs/dvs_settings.h"
+#include "dvs_settings.h"
 
 #include <algorithm>
 #include <cmath>
@@ -21,7 +21,7 @@ std::vector<ParamSpec> dvsParamSpecs() {
                  "voxels", "voxels per grid axis N (source repo default 256)", kRebuild),
         enumParam("voxel_lambert", "normal_weighted", {"normal_weighted", "cosine"},
                   "per-voxel diffuse term: normal_weighted = the paper's per-axis weighting "
-                  "(docs/techniques/dvs.md) | cosine = plain max(N.Psi, 0)",
+                  "(techniques/dvs/README.md) | cosine = plain max(N.Psi, 0)",
                   kRebuild),
         enumParam("voxel_shadows", "shadow_map", {"shadow_map", "raycast", "raycast_soft"},
                   "per-voxel occlusion: shared shadow maps | hard voxel ray | soft ray (E4)",
@@ -51,7 +51,7 @@ std::vector<ParamSpec> dvsParamSpecs() {
         floatParam("max_distance", 0.95, 0.01, 2.0, "grid sides", "cone length limit (repo 0.95)"),
         floatParam("lod_offset", 0.0, -2.0, 2.0, "levels",
                    "added to the cone level log2(radius / v0) (0 = the radius level, one finer "
-                   "than E7's diameter level, as the repo samples; docs/techniques/dvs.md)"),
+                   "than E7's diameter level, as the repo samples; techniques/dvs/README.md)"),
         floatParam("lift", 1.5, 0.0, 4.0, "cells",
                    "keep each sample >= lift x v0 x 2^ceil(L) above the surface plane (no "
                    "self-gather; 0 = off; docs/voxel_cone_tracing.md)"),

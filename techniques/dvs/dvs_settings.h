@@ -2,7 +2,7 @@
 /**
  * Parameters of `dvs` (deferred voxel shading, Villegas; notes 003) and their parsed form.
  * The spec table (dvsParamSpecs) drives help, validation and sweeps; DvsSettings is what the
- * passes read. Every source value is listed in docs/techniques/dvs.md next to our default.
+ * passes read. Every source value is listed in techniques/dvs/README.md next to our default.
  */
 #include <cstdint>
 #include <string>
@@ -49,7 +49,8 @@ DvsSettings dvsSettingsFrom(const ParamSet& params);
 
 /** Full specular cone aperture (deg) for a GGX perceptual roughness: Phong exponent
  *  n = 2 / alpha^2 - 2 (alpha = roughness^2), half angle = arccos(0.5^(1/n)) (half-power angle
- *  of the cos^n lobe), full angle clamped to [1, 60] deg. Mirrored in shaders/dvs/trace.comp. */
+ *  of the cos^n lobe), full angle clamped to [1, 60] deg. Mirrored in
+ * techniques/dvs/shaders/trace.comp. */
 float dvsSpecularApertureDeg(float roughness);
 
 /** Full apex angle of the repo's G1 bounce cones: tan(theta/2) = 0.5 (notes 003 §2.6). */
@@ -57,7 +58,7 @@ inline constexpr uint32_t kDvsBounceConeCount = 4;
 float dvsBounceApertureDeg();
 
 /** The light-sample distance floor of L1 in voxels (emitter samples near a voxel,
- *  docs/techniques/dvs.md). */
+ *  techniques/dvs/README.md). */
 inline constexpr float kDvsEmitterMinDistanceVoxels = 1.0f;
 
 }  // namespace gilab

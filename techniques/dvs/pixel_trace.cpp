@@ -1,4 +1,4 @@
-#include "techniques/dvs/pixel_trace.h"
+#include "pixel_trace.h"
 
 #include <cmath>
 
@@ -12,12 +12,12 @@
 #include "core/vk/context.h"
 #include "core/voxel/cone_set.h"
 #include "core/voxel/voxel_radiance.h"
-#include "techniques/dvs/dvs_gpu.h"
+#include "dvs_gpu.h"
 
 namespace gilab {
 namespace {
 
-/** Mirrors TraceUniforms in shaders/dvs/trace.comp (std140). */
+/** Mirrors TraceUniforms in techniques/dvs/shaders/trace.comp (std140). */
 struct TraceUniforms {
     GpuVoxelGrid grid;
     GpuConeTraceParams cone;

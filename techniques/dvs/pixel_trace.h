@@ -2,7 +2,7 @@
 /**
  * DVS per-pixel pass P1 "trace" (notes 003 §2.8): one compute dispatch over the G-buffer that
  * traces the diffuse cones (+ specular cone, AO, optional cone shadows for the direct layer)
- * through the filtered radiance pyramid. Shader: shaders/dvs/trace.comp.
+ * through the filtered radiance pyramid. Shader: techniques/dvs/shaders/trace.comp.
  * Targets (indirect, direct) are bound on first use and re-bound if their views change.
  */
 #include <vulkan/vulkan.h>
@@ -11,7 +11,7 @@
 #include "core/vk/descriptors.h"
 #include "core/vk/image.h"
 #include "core/vk/pipeline.h"
-#include "techniques/dvs/dvs_settings.h"
+#include "dvs_settings.h"
 
 namespace gilab {
 

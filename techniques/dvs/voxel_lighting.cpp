@@ -1,4 +1,4 @@
-#include "techniques/dvs/voxel_lighting.h"
+#include "voxel_lighting.h"
 
 #include <algorithm>
 
@@ -11,19 +11,19 @@
 #include "core/voxel/cone_set.h"
 #include "core/voxel/voxel_radiance.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/dvs/dvs_gpu.h"
+#include "dvs_gpu.h"
 
 namespace gilab {
 namespace {
 
-/** Mirrors VoxelDirectPush in shaders/dvs/voxel_direct.comp. */
+/** Mirrors VoxelDirectPush in techniques/dvs/shaders/voxel_direct.comp. */
 struct VoxelDirectPush {
     GpuVoxelGrid grid;
     glm::vec4 params;  // x kappa, y min emitter-sample distance (world)
     glm::uvec4 modes;  // x lambert, y shadows, z light count, w shadow maps on
 };
 
-/** Mirrors BounceUniforms in shaders/dvs/voxel_bounce.comp (std140). */
+/** Mirrors BounceUniforms in techniques/dvs/shaders/voxel_bounce.comp (std140). */
 struct BounceUniforms {
     GpuVoxelGrid grid;
     GpuConeTraceParams cone;

@@ -8,7 +8,8 @@
  *                      base = direct + first bounce (via a scratch volume, so the cones may read
  *                      every level while the result is written)
  * The caller runs VoxelRadiance::filter() after each (F). Inputs: the Voxelizer's volumes (in
- * SHADER_READ_ONLY_OPTIMAL) and the ShadowMaps (rendered). Shaders: shaders/dvs/voxel_*.comp.
+ * SHADER_READ_ONLY_OPTIMAL) and the ShadowMaps (rendered). Shaders:
+ * techniques/dvs/shaders/voxel_*.comp.
  */
 #include <memory>
 
@@ -19,7 +20,7 @@
 #include "core/vk/image.h"
 #include "core/vk/pipeline.h"
 #include "core/vk/sampler.h"
-#include "techniques/dvs/dvs_settings.h"
+#include "dvs_settings.h"
 
 namespace gilab {
 

@@ -1,4 +1,4 @@
-#include "techniques/ssvp/ssvp.h"
+#include "ssvp.h"
 
 #include <algorithm>
 #include <cmath>
@@ -17,7 +17,7 @@
 #include "core/vpl/vpl.h"
 #include "core/vpl/vpl_math.h"
 #include "core/vpl/vpl_shading.h"
-#include "techniques/ssvp/ssvp_propagation.h"
+#include "ssvp_propagation.h"
 
 namespace gilab {
 namespace {
@@ -144,7 +144,7 @@ void SsvpTechnique::applySettings(const TechniqueContext& ctx) {
     v.blurRadius = s.blurRadius;
     const uint32_t second = s.secondCount();
     // weights = paper: Eq. 6's 1/N over N = N1 + N2 for both bounces (the first-bounce flux is
-    // already E A / N1 per VPL, so it is scaled by N1 / N; docs/techniques/ssvp.md).
+    // already E A / N1 per VPL, so it is scaled by N1 / N; techniques/ssvp/README.md).
     const float paper = float(s.firstBounceVpls) / float(s.firstBounceVpls + second);
     v.bounceScale = s.paperWeights ? glm::vec2(paper, paper) : glm::vec2(1.0f, 1.0f);
     v.visibility = true;

@@ -1,7 +1,7 @@
 #pragma once
 /**
  * `ssvp`: screen-space VPL propagation with clustered paraboloid maps, V. M. Aranha, M. C. F.
- * Macedo, A. L. Apolinario Jr. Extraction: notes 002; docs/techniques/ssvp.md. Up to two diffuse
+ * Macedo, A. L. Apolinario Jr. Extraction: notes 002; techniques/ssvp/README.md. Up to two diffuse
  * bounces of one main light (spot or directional), everything redone every frame, so a moving
  * light or camera costs nothing beyond a static frame.
  *
@@ -25,7 +25,7 @@
 #include <memory>
 
 #include "core/technique/technique.h"
-#include "techniques/ssvp/ssvp_settings.h"
+#include "ssvp_settings.h"
 
 namespace gilab {
 

@@ -1,4 +1,4 @@
-#include "techniques/ssvp/ssvp_propagation.h"
+#include "ssvp_propagation.h"
 
 #include <algorithm>
 #include <vector>

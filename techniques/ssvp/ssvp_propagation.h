@@ -6,11 +6,10 @@
  * [C, C + C2), whose maps are layers C.. of the same paraboloid array.
  *   recordClustering      K-means over the range's VPLs: seed (first frame), then per
  *                         iteration an assignment dispatch and an update dispatch
- *                         (shaders/ssvp/kmeans_*.comp), warm-started from the previous frame's
- *                         centroids, stopping on convergence or after the iteration cap
- *   recordMembers         after the maps: does each cluster's map see its members
- *                         (map_members.comp; with map_members = reassign, unseen members move to
- *                         a map that sees them and cluster_flux.comp re-sums the fluxes)
+ *                         (techniques/ssvp/shaders/kmeans_*.comp), warm-started from the previous
+ * frame's centroids, stopping on convergence or after the iteration cap recordMembers         after
+ * the maps: does each cluster's map see its members (map_members.comp; with map_members = reassign,
+ * unseen members move to a map that sees them and cluster_flux.comp re-sums the fluxes)
  *   recordSecondBounce    N2 / C VPLs per cluster from its paraboloid map (second_bounce.comp)
  * readState() gives the last frame's iteration count and re-seeded clusters once it finished.
  */
@@ -22,7 +21,7 @@
 #include "core/vk/buffer.h"
 #include "core/vk/descriptors.h"
 #include "core/vk/pipeline.h"
-#include "techniques/ssvp/ssvp_settings.h"
+#include "ssvp_settings.h"
 
 namespace gilab {
 
@@ -63,7 +62,7 @@ public:
     SsvpMemberStats readMemberStats(SsvpRange range);
 
 private:
-    struct Push {  // mirrors KmeansPush in shaders/ssvp/kmeans_common.glsl
+    struct Push {  // mirrors KmeansPush in techniques/ssvp/shaders/kmeans_common.glsl
         float positionWeight, normalWeight, invDiagonal, eyeOffset;
         uint32_t count, clusterCount, iteration, metric, seed, secondCount, perCluster,
             paperWeights, secondVisibility, mapResolution, eyeAtVpl, reassign;

@@ -1,4 +1,4 @@
-#include "techniques/ssvp/ssvp_settings.h"
+#include "ssvp_settings.h"
 
 #include <string>
 
@@ -52,7 +52,7 @@ std::vector<ParamSpec> ssvpParamSpecs() {
                    "split triangles until each edge subtends at most this from the eye"),
         floatParam("centroid_offset", 0.001, 0.0, 0.1, "scene diagonals",
                    "paraboloid eye = centroid + offset x cluster normal (not given in the paper; "
-                   "docs/techniques/ssvp.md)"),
+                   "techniques/ssvp/README.md)"),
         enumParam("map_eye", "centroid", {"centroid", "nearest_vpl"},
                   "paraboloid map eye: the cluster centroid (paper) | the member VPL nearest "
                   "to it (never inside geometry or in the air)"),

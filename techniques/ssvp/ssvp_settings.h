@@ -2,7 +2,7 @@
 /**
  * Parameters of `ssvp` (screen-space VPL propagation, Aranha, Macedo & Apolinario; notes 002)
  * and their parsed form. Defaults are the paper's where it gives them; every other choice is in
- * docs/techniques/ssvp.md.
+ * techniques/ssvp/README.md.
  */
 #include <cstdint>
 #include <vector>
@@ -28,7 +28,7 @@ struct SsvpSettings {
     uint32_t paraboloidResolution = 256;
     uint32_t rsmResolution = 512;
     uint32_t kmeansSeed = 1;
-    // The technique's sampling pattern (docs/techniques/ssvp.md "seed"): a Cranley-Patterson
+    // The technique's sampling pattern (techniques/ssvp/README.md "seed"): a Cranley-Patterson
     // shift of the first-bounce Hammersley VPLs and another K-means start; 0 = the unseeded
     // pattern, bit for bit.
     uint32_t seed = 0;

@@ -1,4 +1,4 @@
-#include "techniques/topovpl/cluster_merge.h"
+#include "cluster_merge.h"
 
 #include <algorithm>
 #include <cmath>

@@ -28,7 +28,7 @@
 #include <glm/glm.hpp>
 
 #include "core/voxel/grid_dims.h"
-#include "techniques/topovpl/skeleton_graph.h"
+#include "skeleton_graph.h"
 
 namespace gilab::topo {
 

@@ -1,7 +1,7 @@
 #pragma once
 /**
  * The two cone tests of the topological VPLs (Noël & Biri 2014 §V-C/D; notes 004 E7, E8), the
- * C++ mirror of shaders/topovpl/topovpl.glsl that the CPU tests check: the conservative
+ * C++ mirror of techniques/topovpl/shaders/topovpl.glsl that the CPU tests check: the conservative
  * sphere test of light assignment must accept every sphere that holds a point the exact test of
  * indirect lighting accepts.
  */

@@ -1,4 +1,4 @@
-#include "techniques/topovpl/gate_lighting.h"
+#include "gate_lighting.h"
 
 #include <algorithm>
 
@@ -7,7 +7,7 @@
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
 #include "core/vpl/vpl.h"
-#include "techniques/topovpl/pixel_clusters.h"
+#include "pixel_clusters.h"
 
 namespace gilab::topo {
 namespace {

@@ -2,15 +2,14 @@
 /**
  * The per-frame passes of `topovpl` after the G-buffer and the VPLs (Noël & Biri 2014 §V;
  * notes 004 §2.B), on the GPU:
- *   recordVplClusters   the visibility cluster of every VPL (shaders/topovpl/vpl_cluster.comp)
- *   recordIugc          unique geometry clusters: tiles x depth slices x visibility cluster,
- *                       local sort, world boxes (iugc.comp)
- *   recordLa            light assignment: per geometry cluster, same-cluster VPLs and
- *                       (VPL, gate) pairs whose cone reaches its bounding sphere (E8); counted,
- *                       scanned, then written (la_assign.comp, la_scan.comp)
- *   recordIl            indirect lighting: the exact gate test (E7), the gather, the near-VPL
- *                       clamp (il.comp) into the frame's indirect layer
- * readStats() reads the last frame's counters (valid once its submission has finished).
+ *   recordVplClusters   the visibility cluster of every VPL
+ * (techniques/topovpl/shaders/vpl_cluster.comp) recordIugc          unique geometry clusters: tiles
+ * x depth slices x visibility cluster, local sort, world boxes (iugc.comp) recordLa light
+ * assignment: per geometry cluster, same-cluster VPLs and (VPL, gate) pairs whose cone reaches its
+ * bounding sphere (E8); counted, scanned, then written (la_assign.comp, la_scan.comp) recordIl
+ * indirect lighting: the exact gate test (E7), the gather, the near-VPL clamp (il.comp) into the
+ * frame's indirect layer readStats() reads the last frame's counters (valid once its submission has
+ * finished).
  */
 #include <cstdint>
 #include <string>
@@ -35,7 +34,7 @@ namespace topo {
 
 class PixelClusters;
 
-/** Mirrors TopoGate in shaders/topovpl/topovpl.glsl (std430). */
+/** Mirrors TopoGate in techniques/topovpl/shaders/topovpl.glsl (std430). */
 struct GpuGate {
     glm::vec4 centreRadius{0.0f};
     glm::vec4 normal{0.0f};

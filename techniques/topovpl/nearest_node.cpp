@@ -1,4 +1,4 @@
-#include "techniques/topovpl/nearest_node.h"
+#include "nearest_node.h"
 
 #include <algorithm>
 #include <array>

@@ -1,10 +1,10 @@
-#include "techniques/topovpl/pixel_clusters.h"
+#include "pixel_clusters.h"
 
 #include "core/passes/gbuffer.h"
 #include "core/util/error.h"
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
-#include "techniques/topovpl/scene_topology.h"
+#include "scene_topology.h"
 
 namespace gilab::topo {
 PixelClusters::PixelClusters(vk::Context& ctx, GBuffer& gbuffer, const SceneTopology& t,

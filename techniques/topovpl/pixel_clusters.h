@@ -1,10 +1,10 @@
 #pragma once
 /**
  * The per-pixel visibility cluster of the topological VPLs (Noël & Biri 2014 §V-A, the cluster
- * index of its G-buffer): shaders/topovpl/pixel_cluster.comp looks every G-buffer pixel up in the
- * topology's voxel-cluster grid (a surface pixel through the empty voxel on its normal's side).
- * Outputs: an R32UI image of cluster ids (0xFFFFFFFF: none) and an RGBA32F debug view coloured
- * by cluster (the glTF export's colours), both in GENERAL after record().
+ * index of its G-buffer): techniques/topovpl/shaders/pixel_cluster.comp looks every G-buffer pixel
+ * up in the topology's voxel-cluster grid (a surface pixel through the empty voxel on its normal's
+ * side). Outputs: an R32UI image of cluster ids (0xFFFFFFFF: none) and an RGBA32F debug view
+ * coloured by cluster (the glTF export's colours), both in GENERAL after record().
  */
 #include <cstdint>
 #include <string>

@@ -1,11 +1,11 @@
-#include "techniques/topovpl/scene_topology.h"
+#include "scene_topology.h"
 
 #include "core/scene/scene.h"
 #include "core/util/error.h"
 #include "core/voxel/distance_transform.h"
 #include "core/voxel/thinning.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/topovpl/nearest_node.h"
+#include "nearest_node.h"
 
 namespace gilab::topo {
 

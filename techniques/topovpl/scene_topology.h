@@ -29,7 +29,7 @@
 
 #include "core/voxel/grid_dims.h"
 #include "core/voxel/voxel_grid.h"
-#include "techniques/topovpl/skeleton_graph.h"
+#include "skeleton_graph.h"
 
 namespace gilab {
 namespace vk {

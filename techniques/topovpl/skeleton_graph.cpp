@@ -1,4 +1,4 @@
-#include "techniques/topovpl/skeleton_graph.h"
+#include "skeleton_graph.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,8 +6,8 @@
 #include <numeric>
 #include <unordered_map>
 
+#include "cluster_merge.h"
 #include "core/util/error.h"
-#include "techniques/topovpl/cluster_merge.h"
 
 namespace gilab::topo {
 namespace {

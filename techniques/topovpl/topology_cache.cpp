@@ -1,4 +1,4 @@
-#include "techniques/topovpl/topology_cache.h"
+#include "topology_cache.h"
 
 #include <algorithm>
 #include <bit>
@@ -18,7 +18,7 @@
 #include "core/util/atomic_file.h"
 #include "core/util/error.h"
 #include "core/util/hash.h"
-#include "techniques/topovpl/nearest_node.h"
+#include "nearest_node.h"
 
 namespace gilab::topo {
 namespace {

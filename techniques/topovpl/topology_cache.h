@@ -33,7 +33,7 @@
 #include <optional>
 #include <string>
 
-#include "techniques/topovpl/scene_topology.h"
+#include "scene_topology.h"
 
 namespace gilab {
 struct Scene;

@@ -1,4 +1,4 @@
-#include "techniques/topovpl/topology_export.h"
+#include "topology_export.h"
 
 #include <cmath>
 #include <cstring>
@@ -7,7 +7,7 @@
 #include <tiny_gltf.h>
 
 #include "core/util/error.h"
-#include "techniques/topovpl/scene_topology.h"
+#include "scene_topology.h"
 
 namespace gilab::topo {
 namespace {

@@ -1,4 +1,4 @@
-#include "techniques/topovpl/topovpl.h"
+#include "topovpl.h"
 
 #include <algorithm>
 #include <cmath>
@@ -16,11 +16,11 @@
 #include "core/vpl/rsm.h"
 #include "core/vpl/vpl.h"
 #include "core/vpl/vpl_math.h"
-#include "techniques/topovpl/gate_lighting.h"
-#include "techniques/topovpl/pixel_clusters.h"
-#include "techniques/topovpl/scene_topology.h"
-#include "techniques/topovpl/topology_cache.h"
-#include "techniques/topovpl/topology_export.h"
+#include "gate_lighting.h"
+#include "pixel_clusters.h"
+#include "scene_topology.h"
+#include "topology_cache.h"
+#include "topology_export.h"
 
 namespace gilab {
 namespace {

@@ -1,7 +1,7 @@
 #pragma once
 /**
  * `topovpl`: real-time global illumination with topological information, S. Noël and V. Biri,
- * GSTF Journal on Computing 4(1), 2014. Extraction: notes 004; docs/techniques/topovpl.md.
+ * GSTF Journal on Computing 4(1), 2014. Extraction: notes 004; techniques/topovpl/README.md.
  * One diffuse bounce of one main light (spot or directional) through VPLs whose visibility is
  * the precomputed topology of the empty space instead of shadow maps: a VPL lights a pixel of
  * its own visibility cluster, or one seen through a gate of its cluster (E6).
@@ -22,7 +22,7 @@
 #include <memory>
 
 #include "core/technique/technique.h"
-#include "techniques/topovpl/topovpl_settings.h"
+#include "topovpl_settings.h"
 
 namespace gilab {
 

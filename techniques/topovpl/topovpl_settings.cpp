@@ -1,4 +1,4 @@
-#include "techniques/topovpl/topovpl_settings.h"
+#include "topovpl_settings.h"
 
 #include <string>
 

@@ -2,7 +2,7 @@
 /**
  * Parameters of `topovpl` (topological visibility-gate VPLs, Noël & Biri 2014; notes 004) and
  * their parsed form. Defaults are the paper's where it gives them (256^3 grid, alpha 20 %, gate
- * radius min of the two balls); every other choice is in docs/techniques/topovpl.md.
+ * radius min of the two balls); every other choice is in techniques/topovpl/README.md.
  */
 #include <cstdint>
 #include <vector>
@@ -27,7 +27,7 @@ struct TopovplSettings {
     bool lifespanFilter = true;       // the authors' thinning filter; false: our spur pruning
     bool useCache = true;
     uint32_t vpls = 1024;  // Table I: 512, 1024, 2048
-    // The VPL pattern (docs/techniques/topovpl.md "seed"): a Cranley-Patterson shift of the
+    // The VPL pattern (techniques/topovpl/README.md "seed"): a Cranley-Patterson shift of the
     // Hammersley points the VPLs read the RSM at; 0 = the unshifted points, bit for bit.
     uint32_t seed = 0;
     uint32_t rsmResolution = 512;

@@ -1,4 +1,4 @@
-#include "techniques/vct/light_injection.h"
+#include "light_injection.h"
 
 #include <algorithm>
 #include <cmath>
@@ -26,7 +26,7 @@ constexpr uint32_t kMinMapSide = 8;
 constexpr uint32_t kMaxTimedBatches = 8;
 constexpr uint32_t kModeCount = 0, kModeIrradiance = 1;
 
-/** Mirrors InjectPush in shaders/vct/inject_common.glsl. */
+/** Mirrors InjectPush in techniques/vct/shaders/inject_common.glsl. */
 struct InjectPush {
     GpuVoxelGrid grid;
     glm::vec4 scale{0.0f};  // x flux units per W, y W per unit, z irradiance units per W/m^2, w inv
@@ -36,7 +36,7 @@ struct InjectPush {
 };
 static_assert(sizeof(InjectPush) == 96);
 
-/** Mirrors LightViewPush in shaders/vct/light_view.glsl. */
+/** Mirrors LightViewPush in techniques/vct/shaders/light_view.glsl. */
 struct LightViewPush {
     glm::mat4 viewProj{1.0f};
     glm::vec4 toLight{0.0f};    // xyz light position (w 0) or unit direction toward it (w 1)

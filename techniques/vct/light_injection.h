@@ -46,7 +46,7 @@
 #include "core/vk/pipeline.h"
 #include "core/vk/sampler.h"
 #include "core/voxel/voxel_grid.h"
-#include "techniques/vct/photons.h"
+#include "photons.h"
 
 namespace gilab {
 struct Scene;
@@ -66,7 +66,7 @@ enum LightViewLobe : uint32_t {
     kLobeCosineTwoSided = 3,  // double-sided emitter sample: |n . w|
 };
 
-/** One light-view map; mirrors LightView in shaders/vct/light_view.glsl (std430). */
+/** One light-view map; mirrors LightView in techniques/vct/shaders/light_view.glsl (std430). */
 struct GpuLightView {
     glm::mat4 viewProj{1.0f};      // world -> Vulkan clip (reversed Z)
     glm::vec4 positionKind{0.0f};  // xyz light position (pinhole) or window centre (ortho);

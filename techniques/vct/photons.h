@@ -2,7 +2,7 @@
 /**
  * The photons of `vct`'s light injection (notes 001 §2.5), shared by the dense splat and the sparse
  * voxel octree. One photon per light-map texel; invalid texels have positionValid.w = 0.
- * Mirrors Photon in shaders/vct/photon.glsl.
+ * Mirrors Photon in techniques/vct/shaders/photon.glsl.
  *
  * `flux` is what the light sends through the texel (so the buffer sums to the light's flux);
  * `irradiance` is the irradiance E = I(w) cos(theta) / r^2 (directional: E_perp cos(theta)) the

@@ -1,4 +1,4 @@
-#include "techniques/vct/svo.h"
+#include "svo.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 #include "core/util/error.h"
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
-#include "techniques/vct/light_injection.h"
+#include "light_injection.h"
 
 namespace gilab::vct {
 namespace {
@@ -52,7 +52,7 @@ glm::uvec3 poolBricks(uint32_t bricks, uint32_t maxDim) {
 }
 
 /**
- * Conservative CPU occupancy of the leaf cells (docs/techniques/vct_svo.md "pool sizing"): every
+ * Conservative CPU occupancy of the leaf cells (techniques/vct/svo.md "pool sizing"): every
  * voxel whose box, grown by a quarter voxel, meets a triangle's bounding box and plane marks the
  * leaf cells whose bricks hold that voxel centre (cells v/2, and v/2 - 1 for even v). It contains
  * the voxelizer's coverage (exact triangle/box overlap), so the GPU build never needs more.
@@ -431,7 +431,7 @@ void SparseVoxelOctree::inject(TechniqueContext& ctx, VkCommandBuffer cmd,
         m_photonSet.writeBuffer(0, *photons.buffer);
     }
     {
-        // docs/techniques/vct_svo.md "Injection": each light's photon range, then per light the
+        // techniques/vct/svo.md "Injection": each light's photon range, then per light the
         // deposit counts and the mean irradiance (E / count per deposit) into the canonical leaf
         // copies.
         PassScope pass(ctx, cmd, "svo_inject");

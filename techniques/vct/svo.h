@@ -1,7 +1,7 @@
 #pragma once
 /**
  * Sparse voxel octree storage of `vct` (Crassin et al. 2011 §4, notes 001 §2.1-2.3, §2.6-2.7,
- * docs/techniques/vct_svo.md). Node pool of 2x2x2 tiles (one child-tile pointer per node, brick
+ * techniques/vct/svo.md). Node pool of 2x2x2 tiles (one child-tile pointer per node, brick
  * pointer, +-x/y/z neighbour pointers, parent pointer); brick pool of vertex-centred 3x3x3 bricks
  * (opacity + premultiplied radiance, alpha-premultiplied albedo). Leaf bricks sample the
  * voxelizer's N^3 volumes at voxel centres (spacing v0); level l bricks have spacing v0 2^l and are
@@ -11,10 +11,10 @@
  * (-X,+X,-Y,+Y,-Z,+Z, rays travelling toward that direction) built by front-to-back pair
  * compositing inside the 3^3 Gaussian; leaves stay isotropic. The radiance pool is indexed by a
  * per-node radiance slot (1 brick, or 6 consecutive bricks for directional nodes); the geometry
- * pool and the flux accumulators by the node's brick index (docs/techniques/vct_svo.md
+ * pool and the flux accumulators by the node's brick index (techniques/vct/svo.md
  * "Anisotropic").
  *
- * Injection as the dense path (docs/techniques/vct_svo.md "Injection"): per light, the photons'
+ * Injection as the dense path (techniques/vct/svo.md "Injection"): per light, the photons'
  * irradiance is averaged over the deposits of their footprints in every leaf sample (count pass,
  * then E / count pass), summed over lights; leaf radiance = a albedo / pi E. Facing (Crassin §7):
  * leaves keep the voxelizer's mean normal in a normal brick pool; leaf samples and the first
@@ -39,11 +39,11 @@
 #include "core/vk/sampler.h"
 #include "core/voxel/voxel_grid.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/vct/photons.h"
+#include "photons.h"
 
 namespace gilab::vct {
 
-/** Mirrors SvoInfo in shaders/vct/svo_common.glsl (uniform buffer, std140). */
+/** Mirrors SvoInfo in techniques/vct/shaders/svo_common.glsl (uniform buffer, std140). */
 struct GpuSvoInfo {
     glm::vec4 originVoxelSize;  // grid minimum corner, w = v0
     glm::uvec4 dims;      // x N, y leaf depth D (root depth 0), z pool bricks along x, w levels
@@ -57,7 +57,7 @@ static_assert(sizeof(GpuSvoInfo) == 320);
 
 class SparseVoxelOctree {
 public:
-    /** Directional filter of an anisotropic octree (docs/techniques/vct_svo.md "Anisotropic"):
+    /** Directional filter of an anisotropic octree (techniques/vct/svo.md "Anisotropic"):
      *  Pairs = the dense rule (front-to-back pairs) on the two pair halves of the 3^3 tent; Slab =
      *  one front-to-back step through the tent's footprint (half-depth end samples). */
     enum class DirectionalFilter : uint32_t { Pairs = 1, Slab = 2 };
@@ -84,7 +84,7 @@ public:
     void updateLights(TechniqueContext& ctx);
     /** Bindings first .. first+3: tree info (uniform buffer), node pool (storage buffer),
      *  radiance brick pool, leaf normal brick pool (combined image samplers); see
-     *  shaders/vct/svo_sample.glsl. */
+     *  techniques/vct/shaders/svo_sample.glsl. */
     static void addLayoutBindings(std::vector<VkDescriptorSetLayoutBinding>& out, uint32_t first,
                                   VkShaderStageFlags stages);
     void writeDescriptors(vk::DescriptorSet& set, uint32_t first) const;

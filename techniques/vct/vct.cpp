@@ -1,4 +1,4 @@
-#include "techniques/vct/vct.h"
+#include "vct.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,8 +20,8 @@
 #include "core/voxel/voxel_debug_view.h"
 #include "core/voxel/voxel_radiance.h"
 #include "core/voxel/voxelizer.h"
-#include "techniques/vct/light_injection.h"
-#include "techniques/vct/svo.h"
+#include "light_injection.h"
+#include "svo.h"
 
 namespace gilab {
 namespace {
@@ -29,7 +29,7 @@ namespace {
 constexpr uint32_t kFlagSpecular = 1u, kFlagAo = 2u, kFlagAnisotropic = 4u, kFlagLevel0Rays = 8u;
 constexpr uint32_t kParamsBinding = 6;
 
-/** Mirrors GatherParams in shaders/vct/gather_inputs.glsl (std140, all vec4). */
+/** Mirrors GatherParams in techniques/vct/shaders/gather_inputs.glsl (std140, all vec4). */
 struct GpuGatherParams {
     glm::vec4 gridMinV0;
     glm::vec4 gridMaxStep;
@@ -107,7 +107,7 @@ TechniqueInfo VctTechnique::describe() {
         enumParam("octree_filter", "slab", {"pairs", "slab"},
                   "octree directional bricks: pairs = the dense rule (front-to-back child pairs "
                   "in the Gaussian, Crassin §9); slab = front to back through the parent's whole "
-                  "footprint (walls on odd samples stay opaque; docs/techniques/vct_svo.md)",
+                  "footprint (walls on odd samples stay opaque; techniques/vct/svo.md)",
                   rebuild),
         boolParam("anisotropic", true,
                   "6 directional mip volumes (dense) or directional bricks above the leaves "
@@ -125,7 +125,7 @@ TechniqueInfo VctTechnique::describe() {
                    "angle of the ring cones from the normal"),
         floatParam("step_factor", 0.5, 0.05, 2.0, "",
                    "cone step d' = step_factor x cone diameter (the paper does not fix it; "
-                   "docs/techniques/vct.md)"),
+                   "techniques/vct/README.md)"),
         floatParam("max_distance", 1.0, 0.01, 2.0, "grid sides",
                    "maximum cone length in units of the voxel grid's side"),
         floatParam("origin_offset", 1.5, 0.0, 8.0, "voxels",
@@ -140,7 +140,7 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("octree_lift_extra", 0.25, 0.0, 1.0, "cells",
                    "added to lift with storage = octree (vertex-centred samples reach further "
                    "than cells): 0.5 = worst-case clearance (no self-gather, +24-38 % energy "
-                   "over dense), 0.25 = matches dense; docs/techniques/vct_svo.md \"Lift\""),
+                   "over dense), 0.25 = matches dense; techniques/vct/svo.md \"Lift\""),
         enumParam("lift_rule", "cell", {"cell", "blend"},
                   "cell: clear the coarser blended level's cell 2^ceil(L) (exact, no self-gather); "
                   "blend: the two cell sizes mixed by the level weight (continuous in t)"),
@@ -419,7 +419,7 @@ void VctTechnique::render(TechniqueContext& ctx, VkCommandBuffer cmd, FrameTarge
     g.distances = glm::vec4(p.getFloat("max_distance") * m_grid.side(), 0.0f,
                             p.getFloat("opacity_cutoff"), p.getFloat("ao_falloff"));
     // The octree's vertex-centred samples carry a surface's data further than cell-centred
-    // voxels do (docs/techniques/vct_svo.md "Lift"): its clearance adds octree_lift_extra cells.
+    // voxels do (techniques/vct/svo.md "Lift"): its clearance adds octree_lift_extra cells.
     const float lift = p.getFloat("lift");
     const float octreeExtra = p.getFloat("octree_lift_extra");
     g.misc =

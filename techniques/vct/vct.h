@@ -1,7 +1,7 @@
 #pragma once
 /**
  * `vct`: voxel cone tracing, Crassin, Neyret, Sainz, Green, Eisemann, "Interactive Indirect
- * Illumination Using Voxel Cone Tracing", CGF 30(7) 2011 (notes 001, docs/techniques/vct.md).
+ * Illumination Using Voxel Cone Tracing", CGF 30(7) 2011 (notes 001, techniques/vct/README.md).
  *
  * Set-up (timed): "voxelize" + "voxel_resolve" (core/voxel Voxelizer), "inject" (light-view maps,
  * one photon per texel, splat, voxel shade: techniques/vct/light_injection.h), "filter"

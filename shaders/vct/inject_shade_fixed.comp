@@ -1,6 +1,0 @@
-#version 460
-#extension GL_GOOGLE_include_directive : require
-// Voxel shade into an RGBA16F radiance base, fixed-point flux sums: see inject_shade_body.glsl.
-#define INJECT_FORMAT rgba16f
-#define INJECT_FIXED_POINT
-#include "vct/inject_shade_body.glsl"
