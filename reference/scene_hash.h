@@ -18,7 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "core/scene/scene.h"
-#include "reference/path_tracer.h"
+#include "reference/reference_settings.h"
 
 namespace gilab::ref {
 
