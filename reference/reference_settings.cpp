@@ -1,5 +1,7 @@
 #include "reference/reference_settings.h"
 
+#include <nlohmann/json.hpp>
+
 namespace gilab::ref {
 
 const char* layerName(Layer layer) {
@@ -34,6 +36,24 @@ const char* estimatorName(Estimator e) {
             return "bsdf";
     }
     return "?";
+}
+
+nlohmann::ordered_json settingsJson(const ReferenceSettings& settings) {
+    // Tripwire: this binding names every field, so a field added to ReferenceSettings stops the
+    // build here until it is serialised below (and, if it does not change the image, listed in
+    // kSettingsNotInKey, reference/scene_hash.h). Keep the order of the struct.
+    const auto& [maxBounces, rouletteStartBounce, rouletteThreshold, estimator, seed, pixelFilter,
+                 sampler, sobolReplicate, batchSamples] = settings;
+    static_assert(sizeof(ReferenceSettings) == 40, "ReferenceSettings changed: serialise it here");
+    return {{"max_bounces", maxBounces},
+            {"roulette_start_bounce", rouletteStartBounce},
+            {"roulette_threshold", rouletteThreshold},
+            {"estimator", estimatorName(estimator)},
+            {"seed", seed},
+            {"pixel_filter", pixelFilterName(pixelFilter)},
+            {"sampler", samplerKindName(sampler)},
+            {"sobol_replicate", sobolReplicate},
+            {"batch_samples", batchSamples}};
 }
 
 }  // namespace gilab::ref

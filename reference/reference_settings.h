@@ -3,12 +3,13 @@
  * The reference path tracer's settings types, apart from the tracer (reference/path_tracer.h)
  * so that code that only configures, names or keys a render (the cache key, experiment configs,
  * the command line) does not pull in Embree's side: the layers, the estimator, the pixel
- * filter, ReferenceSettings, the renderer version, the stop criteria and the recorded-ray
- * record.
+ * filter, ReferenceSettings and its one JSON serialisation (settingsJson), the renderer
+ * version, the stop criteria and the recorded-ray record.
  */
 #include <cstdint>
 
 #include <glm/glm.hpp>
+#include <nlohmann/json_fwd.hpp>
 
 #include "reference/sampling.h"
 
@@ -61,6 +62,16 @@ struct ReferenceSettings {
      *  to 16 samples of a tile's pixels are traced as one wavefront (docs/reference.md). */
     uint32_t batchSamples = 16;
 };
+
+/**
+ * Every field of `settings`, by name (snake_case; enums by their names): the one serialisation
+ * of ReferenceSettings. It is the sidecar's "settings" block (reference/cache.cpp) and the cache
+ * key hashes its dump (keySettingsJson, reference/scene_hash.h), so a field missing here would
+ * let renders that differ in it share a cache entry. A new field goes here (a compile error in
+ * reference_settings.cpp says so); if it does not change the image, name it in
+ * kSettingsNotInKey (reference/scene_hash.h) as well.
+ */
+nlohmann::ordered_json settingsJson(const ReferenceSettings& settings);
 
 /** When to stop: whichever comes first; 0 disables a criterion (at least one must be set). */
 struct StopCriteria {
