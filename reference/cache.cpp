@@ -354,18 +354,6 @@ nlohmann::ordered_json stopCriteriaJson(const StopCriteria& stop) {
             {"max_seconds", stop.maxSeconds}};
 }
 
-nlohmann::ordered_json settingsJson(const ReferenceSettings& settings) {
-    return {{"max_bounces", settings.maxBounces},
-            {"roulette_start_bounce", settings.rouletteStartBounce},
-            {"roulette_threshold", settings.rouletteThreshold},
-            {"estimator", estimatorName(settings.estimator)},
-            {"seed", settings.seed},
-            {"pixel_filter", pixelFilterName(settings.pixelFilter)},
-            {"sampler", samplerKindName(settings.sampler)},
-            {"sobol_replicate", settings.sobolReplicate},
-            {"batch_samples", settings.batchSamples}};
-}
-
 namespace {
 
 /** The criterion a stored entry meets (OR-ed as in renderUntil), if any. */

@@ -121,7 +121,6 @@ ReferenceResult obtainReference(const Scene& scene, const ReferenceSettings& set
 
 /** {"max_samples", "target_rel_error", "max_seconds"} (0 = off). */
 nlohmann::ordered_json stopCriteriaJson(const StopCriteria& stop);
-/** {"max_bounces", "roulette_start_bounce", "estimator", "seed", "batch_samples"}. */
-nlohmann::ordered_json settingsJson(const ReferenceSettings& settings);
+// settingsJson(ReferenceSettings), the sidecar's "settings": reference/reference_settings.h.
 
 }  // namespace gilab::ref

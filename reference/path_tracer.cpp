@@ -112,42 +112,8 @@ void setRayPackets(bool enabled) {
     g_rayPackets = enabled;
 }
 
-const char* layerName(Layer layer) {
-    switch (layer) {
-        case Layer::Full:
-            return "full";
-        case Layer::Emission:
-            return "emission";
-        case Layer::Direct:
-            return "direct";
-        case Layer::Bounce1:
-            return "bounce1";
-        case Layer::Bounce2:
-            return "bounce2";
-        case Layer::Bounce3Plus:
-            return "bounce3plus";
-    }
-    return "?";
-}
-
-const char* pixelFilterName(PixelFilter f) {
-    return f == PixelFilter::Center ? "center" : "box";
-}
-
 const char* samplerKindName(SamplerKind k) {
     return k == SamplerKind::Sobol ? "sobol" : "independent";
-}
-
-const char* estimatorName(Estimator e) {
-    switch (e) {
-        case Estimator::Mis:
-            return "mis";
-        case Estimator::NeeOnly:
-            return "nee";
-        case Estimator::BsdfOnly:
-            return "bsdf";
-    }
-    return "?";
 }
 
 namespace {

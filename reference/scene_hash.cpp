@@ -25,7 +25,7 @@ static_assert(sizeof(Material) == sizeof(std::string) + 64,
               "Material changed: update hashMaterial()");
 static_assert(sizeof(Texture) == sizeof(std::string) + sizeof(std::vector<uint8_t>) + 24,
               "Texture changed: update hashTexture()");
-static_assert(sizeof(ReferenceSettings) == 40, "ReferenceSettings changed: update the key");
+// ReferenceSettings has its tripwire in settingsJson() (reference_settings.cpp).
 static_assert(std::endian::native == std::endian::little, "hashes assume little-endian data");
 
 std::string toHex(XXH128_hash_t h) {
@@ -188,6 +188,16 @@ std::string hashSceneData(const Scene& scene) {
     return h.hex();
 }
 
+nlohmann::ordered_json keySettingsJson(const ReferenceSettings& settings) {
+    nlohmann::ordered_json j = settingsJson(settings);
+    for (std::string_view name : kSettingsNotInKey)
+        j.erase(std::string(name));
+    if (settings.sampler != SamplerKind::Sobol)
+        for (std::string_view name : kSobolOnlySettings)
+            j.erase(std::string(name));
+    return j;
+}
+
 ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& settings) {
     ReferenceKey key;
     const std::string dataHash = hashSceneData(scene);
@@ -196,15 +206,11 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
     h.tag("gilab-reference-key");
     h.i32(kKeyFormatVersion);
     h.i32(kRendererVersion);
-    h.tag("settings");  // batchSamples does not change the image (determinism contract)
-    h.i32(settings.maxBounces);
-    h.i32(settings.rouletteStartBounce);
-    h.u64(std::bit_cast<uint32_t>(settings.rouletteThreshold));
-    h.i32(int32_t(settings.estimator));
-    h.u64(settings.seed);
-    h.i32(int32_t(settings.pixelFilter));
-    h.i32(int32_t(settings.sampler));
-    if (settings.sampler == SamplerKind::Sobol) h.u64(settings.sobolReplicate);
+    // The settings as the sidecar serialises them (one serialisation: reference_settings.h),
+    // less the named exclusions; floats print exactly (shortest round-trip text)
+    const nlohmann::ordered_json keySettings = keySettingsJson(settings);
+    h.tag("settings");
+    h.str(keySettings.dump());
     h.tag("scene_data");
     h.str(dataHash);
 
@@ -220,32 +226,28 @@ ReferenceKey computeReferenceKey(const Scene& scene, const ReferenceSettings& se
     }
     key.hex = h.hex();
 
-    key.description = {
-        {"key", key.hex},
-        {"hash", "XXH3-128"},
-        {"key_format", kKeyFormatVersion},
-        {"renderer_version", kRendererVersion},
-        {"settings",
-         {{"max_bounces", settings.maxBounces},
-          {"roulette_start_bounce", settings.rouletteStartBounce},
-          {"roulette_threshold", settings.rouletteThreshold},
-          {"estimator", estimatorName(settings.estimator)},
-          {"seed", settings.seed},
-          {"pixel_filter", pixelFilterName(settings.pixelFilter)},
-          {"sampler", samplerKindName(settings.sampler)},
-          {"sobol_replicate", settings.sobolReplicate}}},
-        {"scene_data_xxh3_128", dataHash},
-        {"scene_data",
-         {{"vertices", scene.vertices.size()},
-          {"triangles", scene.triangleCount()},
-          {"materials", scene.materials.size()},
-          {"textures", scene.textures.size()},
-          {"lights", scene.lights.size()},
-          {"resolution", {scene.settings.width, scene.settings.height}}}},
-        {"files", files},
-        {"not_hashed",
-         "batch_samples (batching does not change the image), names, paths, warnings, "
-         "exposure_ev (previews only)"}};
+    std::string notHashed;
+    for (std::string_view name : kSettingsNotInKey)
+        notHashed += std::string(name) + ", ";
+    for (std::string_view name : kSobolOnlySettings)
+        notHashed += std::string(name) + " (unless the sampler is sobol), ";
+    notHashed += "names, paths, warnings, exposure_ev (previews only)";
+
+    key.description = {{"key", key.hex},
+                       {"hash", "XXH3-128"},
+                       {"key_format", kKeyFormatVersion},
+                       {"renderer_version", kRendererVersion},
+                       {"settings", keySettings},
+                       {"scene_data_xxh3_128", dataHash},
+                       {"scene_data",
+                        {{"vertices", scene.vertices.size()},
+                         {"triangles", scene.triangleCount()},
+                         {"materials", scene.materials.size()},
+                         {"textures", scene.textures.size()},
+                         {"lights", scene.lights.size()},
+                         {"resolution", {scene.settings.width, scene.settings.height}}}},
+                       {"files", files},
+                       {"not_hashed", notHashed}};
     return key;
 }
 

@@ -2,14 +2,18 @@
 // `gilab reference` end to end (docs/reference_cache.md). Tiny images, few samples.
 #include <unistd.h>
 
+#include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <optional>
 #include <set>
+#include <string_view>
 #include <thread>
 
 #include <gtest/gtest.h>
@@ -25,6 +29,7 @@
 #include "experiments/cli/interrupt.h"
 #include "reference/bench.h"
 #include "reference/cache.h"
+#include "reference/reference_settings.h"
 #include "reference/scene_hash.h"
 
 namespace gilab {
@@ -103,6 +108,45 @@ nlohmann::json readJson(const fs::path& path) {
 
 const std::string kKey = std::string(32, 'a');
 
+/**
+ * One edit per field of ReferenceSettings, by its name in ref::settingsJson(), moving the field
+ * away from its value (a valid setting still: the Sobol replicate stays a power of two). The
+ * test below requires these names to be exactly the keys of the serialisation, so a field added
+ * to settingsJson() needs an edit here and one dropped from it fails; a field added to the
+ * struct but not to settingsJson() stops the build there (its structured binding).
+ */
+const std::map<std::string, std::function<void(ref::ReferenceSettings&)>>& settingEdits() {
+    static const std::map<std::string, std::function<void(ref::ReferenceSettings&)>> edits = {
+        {"max_bounces", [](ref::ReferenceSettings& r) { r.maxBounces += 1; }},
+        {"roulette_start_bounce", [](ref::ReferenceSettings& r) { r.rouletteStartBounce += 1; }},
+        {"roulette_threshold", [](ref::ReferenceSettings& r) { r.rouletteThreshold *= 0.5f; }},
+        {"estimator",
+         [](ref::ReferenceSettings& r) {
+             r.estimator =
+                 r.estimator == ref::Estimator::Mis ? ref::Estimator::NeeOnly : ref::Estimator::Mis;
+         }},
+        {"seed", [](ref::ReferenceSettings& r) { r.seed += 1; }},
+        {"pixel_filter",
+         [](ref::ReferenceSettings& r) {
+             r.pixelFilter = r.pixelFilter == ref::PixelFilter::Box ? ref::PixelFilter::Center
+                                                                    : ref::PixelFilter::Box;
+         }},
+        {"sampler",
+         [](ref::ReferenceSettings& r) {
+             r.sampler = r.sampler == ref::SamplerKind::Sobol ? ref::SamplerKind::Independent
+                                                              : ref::SamplerKind::Sobol;
+         }},
+        {"sobol_replicate", [](ref::ReferenceSettings& r) { r.sobolReplicate /= 2; }},
+        {"batch_samples", [](ref::ReferenceSettings& r) { r.batchSamples *= 2; }},
+    };
+    return edits;
+}
+
+template <size_t N>
+bool listed(const std::array<std::string_view, N>& list, const std::string& name) {
+    return std::find(list.begin(), list.end(), name) != list.end();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -164,6 +208,77 @@ TEST(CpuReferenceKey, BatchSamplesNamesAndExposureKeepTheKey) {
     scene.materials[0].name = "renamed";
     scene.settings.exposureEv = 2.0f;
     EXPECT_EQ(ref::referenceKey(scene, tinySettings()), base);
+}
+
+TEST(CpuReferenceKey, EverySettingChangesTheKeyUnlessExcludedByName) {
+    const Scene scene = tinyScene();
+    const ref::ReferenceSettings defaults;
+    const nlohmann::ordered_json serialised = ref::settingsJson(defaults);
+    ref::ReferenceSettings sobol = defaults;
+    sobol.sampler = ref::SamplerKind::Sobol;
+
+    // The exclusions name real fields (a typo would exclude nothing)
+    for (std::string_view name : ref::kSettingsNotInKey)
+        EXPECT_TRUE(serialised.contains(std::string(name))) << name;
+    for (std::string_view name : ref::kSobolOnlySettings)
+        EXPECT_TRUE(serialised.contains(std::string(name))) << name;
+
+    // Every serialised field has an edit, and every edit's field is serialised
+    std::set<std::string> names;
+    for (const auto& item : serialised.items()) {
+        names.insert(item.key());
+        EXPECT_TRUE(settingEdits().count(item.key())) << "no edit for the field " << item.key();
+    }
+    for (const auto& [name, edit] : settingEdits())
+        EXPECT_TRUE(names.count(name)) << name << " is not in ref::settingsJson()";
+
+    // Each edit changes its own field of the serialisation, and the key unless excluded; from
+    // the defaults, and from the Sobol sampler, which reads the Sobol-only fields
+    for (const auto& [name, edit] : settingEdits()) {
+        for (const ref::ReferenceSettings& base : {defaults, sobol}) {
+            const bool isSobol = base.sampler == ref::SamplerKind::Sobol;
+            ref::ReferenceSettings changed = base;
+            edit(changed);
+            const nlohmann::ordered_json before = ref::settingsJson(base);
+            nlohmann::ordered_json after = ref::settingsJson(changed);
+            if (before.contains(name)) {  // (else reported above; the key is still checked)
+                EXPECT_NE(after[name], before[name]) << name << " (sobol " << isSobol << ")";
+                after[name] = before[name];
+                EXPECT_EQ(after, before) << "the edit of " << name << " changes other fields";
+            }
+
+            const bool excluded = listed(ref::kSettingsNotInKey, name) ||
+                                  (!isSobol && listed(ref::kSobolOnlySettings, name));
+            const bool keyChanged =
+                ref::referenceKey(scene, changed) != ref::referenceKey(scene, base);
+            EXPECT_EQ(keyChanged, !excluded)
+                << name
+                << (excluded ? " is excluded from the key but changes it"
+                             : " changes the image but not the key")
+                << " (sobol " << isSobol << ")";
+        }
+    }
+}
+
+TEST(CpuReferenceKey, SidecarHoldsEverySetting) {
+    ref::ReferenceSettings settings = tinySettings();
+    for (const auto& [name, edit] : settingEdits())
+        edit(settings);  // every field away from tinySettings()
+    const ref::ReferenceResult r =
+        ref::obtainReference(tinyScene(), settings, samplesStop(1), nullptr);
+    ASSERT_TRUE(r.sidecar.contains("settings"));
+    const nlohmann::ordered_json& stored = r.sidecar["settings"];
+    EXPECT_EQ(stored, ref::settingsJson(settings));
+    const nlohmann::ordered_json plain = ref::settingsJson(tinySettings());
+    for (const auto& [name, edit] : settingEdits()) {
+        ASSERT_TRUE(stored.contains(name)) << name;
+        EXPECT_NE(stored[name], plain[name]) << name;
+    }
+    // The key's description lists the settings it hashed: all but the excluded ones
+    for (const auto& item : stored.items())
+        EXPECT_EQ(r.sidecar["key_description"]["settings"].contains(item.key()),
+                  !listed(ref::kSettingsNotInKey, item.key()))
+            << item.key();
 }
 
 TEST(CpuReferenceKey, LoadedFileBytesChangeTheKey) {

@@ -13,7 +13,7 @@
 #include "core/technique/registry.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/interrupt.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 #include "experiments/runner/run_store.h"
 #include "experiments/runner/runner.h"
 #include "tests/gpu_test_fixture.h"

@@ -13,7 +13,7 @@
 #include "core/util/json_reader.h"
 #include "experiments/audit/audit_internal.h"
 #include "experiments/audit/child_process.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 
 namespace gilab::audit {
 

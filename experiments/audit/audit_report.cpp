@@ -2,7 +2,7 @@
 #include <cstdio>
 
 #include "experiments/audit/audit.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 
 namespace gilab::audit {
 

@@ -9,7 +9,7 @@
 #include "core/util/error.h"
 #include "core/util/progress.h"
 #include "experiments/cli/cli.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 #include "reference/bench.h"
 
 namespace gilab::cli {

@@ -24,9 +24,9 @@
 #include "experiments/cli/cli.h"
 #include "experiments/cli/leak_causes.h"
 #include "experiments/cli/light_placements.h"
-#include "experiments/cli/run_metadata.h"
 #include "experiments/metrics/direct_accuracy.h"
 #include "experiments/metrics/metrics.h"
+#include "experiments/runner/run_metadata.h"
 #include "reference/cache.h"
 
 namespace gilab::cli {

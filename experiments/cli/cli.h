@@ -13,7 +13,7 @@
 #include "core/params/params.h"
 #include "core/scene/scene.h"
 #include "core/util/error.h"
-#include "reference/path_tracer.h"
+#include "reference/reference_settings.h"
 
 namespace gilab::cli {
 

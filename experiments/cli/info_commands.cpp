@@ -6,7 +6,7 @@
 #include "core/scene/scene_loader.h"
 #include "core/vk/context.h"
 #include "experiments/cli/cli.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 
 namespace gilab::cli {
 

@@ -15,7 +15,7 @@
 #include "core/util/progress.h"
 #include "experiments/cli/cli.h"
 #include "experiments/cli/interrupt.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 #include "experiments/runner/run_sequence.h"
 #include "reference/cache.h"
 

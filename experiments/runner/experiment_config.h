@@ -15,7 +15,7 @@
 
 #include "core/image/image_io.h"
 #include "core/params/params.h"
-#include "reference/path_tracer.h"
+#include "reference/reference_settings.h"
 
 namespace gilab::exp {
 

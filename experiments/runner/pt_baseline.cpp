@@ -5,7 +5,8 @@
 
 #include "core/technique/registry.h"
 #include "core/util/error.h"
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
+#include "reference/path_tracer.h"
 
 namespace gilab::exp {
 namespace {

@@ -17,7 +17,7 @@
 #include "core/image/image.h"
 #include "core/params/params.h"
 #include "core/scene/scene.h"
-#include "reference/path_tracer.h"
+#include "reference/reference_settings.h"
 
 namespace gilab::exp {
 

@@ -6,8 +6,8 @@
 
 #include "core/scene/animation.h"
 #include "core/util/error.h"
-#include "experiments/cli/run_metadata.h"
 #include "experiments/metrics/metrics.h"
+#include "experiments/runner/run_metadata.h"
 
 namespace gilab::exp {
 namespace fs = std::filesystem;

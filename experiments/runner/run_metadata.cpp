@@ -1,4 +1,4 @@
-#include "experiments/cli/run_metadata.h"
+#include "experiments/runner/run_metadata.h"
 
 #include <unistd.h>
 #include <limits>
