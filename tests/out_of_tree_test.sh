@@ -62,6 +62,24 @@ grep -q "$id" "results/${id}_vs_direct/report.html" || fail "$id is not in the r
 grep -q '1 declared, 0 red' "$tmp/audit.log" || { cat "$tmp/audit.log"; fail "audit counts"; }
 grep -q '| saturated_walls | .* | declared ' audit/audit.md || { cat audit/audit.md; fail "audit table"; }
 
+# The long form of the CMake line must list every stage in shaders/: one left out is a configure
+# error naming it, not a shader missing at run time.
+mkdir -p "$tmp/long"
+cp -r "$tmp/ambient/shaders" "$tmp/ambient/ambient.cpp" "$tmp/long/"
+cp "$tmp/ambient/shaders/ambient.comp" "$tmp/long/shaders/unlisted.comp"
+cat >"$tmp/long/CMakeLists.txt" <<CMAKE
+cmake_minimum_required(VERSION 3.25)
+project(long LANGUAGES CXX)
+find_package(gilab REQUIRED)
+gilab_add_technique($id SOURCES ambient.cpp SHADERS shaders/ambient.comp)
+CMAKE
+if cmake -S "$tmp/long" -B "$tmp/long/build" -G "$generator" -DCMAKE_PREFIX_PATH="$tmp/prefix" \
+    >"$tmp/long.log" 2>&1; then
+    fail "an unlisted shader did not stop the configure"
+fi
+grep -q "shaders/unlisted.comp is not in SHADERS" "$tmp/long.log" || {
+    cat "$tmp/long.log"; fail "the configure error does not name the unlisted shader"; }
+
 # A module built against another gilab version is refused, naming the file and both versions.
 mkdir -p "$tmp/wrong"
 # (its gilab_module_abi() says what the one built from another gilab's headers would say)
