@@ -62,6 +62,12 @@ grep -q "$id" "results/${id}_vs_direct/report.html" || fail "$id is not in the r
 grep -q '1 declared, 0 red' "$tmp/audit.log" || { cat "$tmp/audit.log"; fail "audit counts"; }
 grep -q '| saturated_walls | .* | declared ' audit/audit.md || { cat audit/audit.md; fail "audit table"; }
 
+# `cmake --install` of the module into gilab's prefix puts it where gilab looks beside itself.
+cmake --install "$tmp/ambient/build" --prefix "$tmp/prefix" >/dev/null
+GILAB_TECHNIQUE_PATH= "$gilab" list >"$tmp/list2.txt"
+grep -A1 "^$id " "$tmp/list2.txt" | grep -q "from: $tmp/prefix/.*gilab/techniques/gilab-technique-$id.so" || {
+    cat "$tmp/list2.txt"; fail "the installed module is not found beside the binary"; }
+
 # The long form of the CMake line must list every stage in shaders/: one left out is a configure
 # error naming it, not a shader missing at run time.
 mkdir -p "$tmp/long"

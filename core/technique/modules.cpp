@@ -62,8 +62,7 @@ ModuleSearch moduleSearch(const std::vector<std::string>& dirs, fs::path executa
     std::error_code ec;
     if (executable.empty()) executable = fs::read_symlink("/proc/self/exe", ec);
     if (!executable.empty())
-        search.besideBinary =
-            executable.parent_path().parent_path() / "lib" / "gilab" / "techniques";
+        search.besideBinary = executable.parent_path().parent_path() / GILAB_MODULE_DIR_FROM_PREFIX;
     return search;
 }
 

@@ -5,7 +5,8 @@
  * Searched, in order (docs/architecture.md, "Technique modules"):
  *   1. every --technique-dir given on the command line (a folder or a .so file);
  *   2. every entry of GILAB_TECHNIQUE_PATH (':'-separated folders or .so files);
- *   3. the folder <binary dir>/../lib/gilab/techniques beside an installed gilab.
+ *   3. the folder <binary dir>/../<libdir>/gilab/techniques beside an installed gilab (libdir:
+ *      lib, or lib/<multiarch> for a /usr prefix on Debian; where gilab_add_technique installs).
  * A module built against another gilab version (core/technique/module_abi.h) is refused with an
  * error naming the file and both versions; so is a file that is not a gilab module.
  */
@@ -17,7 +18,7 @@ namespace gilab {
 
 struct ModuleSearch {
     std::vector<std::filesystem::path> explicitPaths;  // --technique-dir, then the variable
-    std::filesystem::path besideBinary;                // <binary dir>/../lib/gilab/techniques
+    std::filesystem::path besideBinary;                // <binary dir>/../<libdir>/gilab/techniques
 };
 
 /** The search of this process: `dirs` (the command line), GILAB_TECHNIQUE_PATH, the folder

@@ -163,7 +163,7 @@ int runMain(int argc, char** argv) {
     app.add_option("--technique-dir", techniqueDirs,
                    "Load technique modules (gilab-technique-<id>.so) from this folder or file; "
                    "repeatable. Also searched: GILAB_TECHNIQUE_PATH (':'-separated) and "
-                   "<binary dir>/../lib/gilab/techniques (docs/architecture.md)");
+                   "<binary dir>/../<libdir>/gilab/techniques (docs/architecture.md)");
 
     bool listJson = false;
     CLI::App* list = app.add_subcommand("list", "List techniques and their parameters");
