@@ -153,6 +153,22 @@ TEST(CpuAudit, MalformedDeclarationNamesTheFile) {
     EXPECT_TRUE(declaredWeaknesses("vct").empty());
 }
 
+TEST(CpuAudit, ADeclaredCaseMissingFromTheCatalogStopsTheAuditBeforeAnyCell) {
+    test::TempDir dir;
+    AuditOptions o;
+    o.techniques = {"declaring"};  // declares "stiff", which audit.json does not have
+    o.outDir = (dir.path() / "audit").string();
+    o.quiet = true;
+    try {
+        runAudit(o);
+        FAIL() << "no error";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("declares case \"stiff\""), std::string::npos)
+            << e.what();
+    }
+    EXPECT_FALSE(fs::exists(dir.path() / "audit")) << "a cell ran before the check";
+}
+
 TEST(CpuAudit, RefusalIsGreenOnlyWhenItNamesTheParameter) {
     AuditCase p;
     p.parameterCase = true;

@@ -1,5 +1,6 @@
 // runAudit: the reference checks and the technique x case cells in order, then the scale
 // comparisons; the table is rewritten after every cell so a killed audit keeps what it has.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -106,6 +107,16 @@ AuditSummary runAudit(const AuditOptions& o) {
     if (techniques.empty())
         for (const TechniqueInfo* info : TechniqueRegistry::instance().list())
             techniques.push_back(info->id);
+    // Each technique's declared weaknesses are read before any cell runs, so a malformed file or
+    // a case name the catalog does not have (a typo would never apply) stops the audit up front.
+    for (const std::string& t : techniques)
+        for (const auto& [name, why] : declaredWeaknesses(t)) {
+            const bool known = std::any_of(catalog.cases.begin(), catalog.cases.end(),
+                                           [&](const AuditCase& c) { return c.name == name; });
+            if (!known)
+                throw Error(t + "/known_weaknesses.json declares case \"" + name +
+                            "\", which the catalog " + catalogPath + " does not have");
+        }
     AuditPaths paths;
     paths.out = o.outDir;
     paths.cache = o.referenceCache.empty() ? paths.out / "cache" : fs::path(o.referenceCache);
