@@ -94,7 +94,7 @@ for f in files:
 
 # 7. Layering: core/'s layers include only their own or lower ones; core/ names no technique and
 #    includes nothing outside core/; the runner never includes the command line.
-rank = {'util': 0, 'scene': 1, 'image': 1, 'params': 1, 'vk': 2, 'gpu': 2, 'passes': 3, 'voxel': 3,
+rank = {'util': 0, 'scene': 1, 'image': 1, 'params': 1, 'vk': 2, 'gpu': 2, 'rt': 3, 'passes': 3, 'voxel': 3,
         'vpl': 4, 'technique': 5}
 for f in files:
     if not f.endswith(('.h', '.cpp')): continue

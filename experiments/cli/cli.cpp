@@ -377,6 +377,24 @@ int runMain(int argc, char** argv) {
     benchDirectCmd->add_option("--out,-o", benchDirect.outDir, "Also write bench_direct.json here");
     benchDirectCmd->add_flag("--quiet,-q", benchDirect.quiet, "No progress lines");
 
+    BenchRtOptions benchRt;
+    benchRt.commandLine = commandLine;
+    CLI::App* benchRtCmd = bench->add_subcommand(
+        "rt",
+        "The GPU ray tracer against Embree on every shipped scene: closest hits and occlusion of "
+        "random rays, checked against the agreement rules (docs/gpu_rays.md)");
+    benchRtCmd->add_option("--scene", benchRt.scenes,
+                           "Scene (repeatable); default: builtin and scenes/*.json");
+    benchRtCmd->add_option("--rays", benchRt.rays, "Rays per scene")
+        ->check(CLI::Range(uint64_t(1), uint64_t(1) << 30))
+        ->capture_default_str();
+    benchRtCmd->add_option("--seed", benchRt.seed, "Seed of the rays")->capture_default_str();
+    benchRtCmd->add_option("--out,-o", benchRt.outPath, "Also write the results to this JSON file");
+    benchRtCmd->add_option("--device", benchRt.device, "Vulkan device name substring or index");
+    benchRtCmd->add_flag("--validation", benchRt.validation,
+                         "Enable Vulkan validation layers (any message: exit code 5)");
+    benchRtCmd->add_flag("--quiet,-q", benchRt.quiet, "No progress lines");
+
     BenchLightPowerOptions benchPower;
     CLI::App* benchPowerCmd = bench->add_subcommand(
         "light-power",
@@ -527,6 +545,7 @@ int runMain(int argc, char** argv) {
         if (*benchRefCmd) return runBenchReference(benchRef);
         if (*benchDirectCmd) return runBenchDirect(benchDirect);
         if (*benchPowerCmd) return runBenchLightPower(benchPower);
+        if (*benchRtCmd) return runBenchRt(benchRt);
         if (*benchTechCmd) {
             for (const std::string& t : benchTech.techniques)
                 checkTechniqueName(t);

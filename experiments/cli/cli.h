@@ -109,6 +109,20 @@ struct BenchDirectOptions {
 };
 int runBenchDirect(const BenchDirectOptions& options);
 
+/** `gilab bench rt`: the GPU ray tracer (core/rt) against Embree, random rays on every shipped
+ *  scene (reference/rt_validation.h, docs/gpu_rays.md); exit 1 when a scene breaks the rules. */
+struct BenchRtOptions {
+    std::vector<std::string> scenes;  // default: the built-in Cornell box and scenes/*.json
+    uint64_t rays = 1'000'000;        // per scene
+    uint64_t seed = 1;
+    std::string outPath;  // "" = print only
+    std::string device;
+    bool validation = false;
+    bool quiet = false;
+    std::string commandLine;
+};
+int runBenchRt(const BenchRtOptions& options);
+
 /** Options of `gilab reference` (docs/reference_cache.md), also used by tests. */
 struct ReferenceOptions {
     std::string scenePath;  // "" = the built-in Cornell box
