@@ -229,11 +229,13 @@ std::vector<std::pair<std::string, std::vector<nlohmann::json>>> parseAxes(const
 }
 
 TechniqueEntry parseTechnique(const JsonNode& node, const std::set<std::string>& sceneLabels) {
-    node.expectKeys({"technique", "params", "sweep", "shared", "scenes", "repeats", "frames"});
+    node.expectKeys(
+        {"technique", "params", "sweep", "shared", "scenes", "repeats", "frames", "warmup"});
     TechniqueEntry t;
     t.id = node["technique"].string();
     if (node.has("repeats")) t.repeats = node["repeats"].integerIn(1, 1000);
     if (node.has("frames")) t.timedFrames = node["frames"].integerIn(1, 100000);
+    if (node.has("warmup")) t.warmupFrames = node["warmup"].integerIn(0, 1000);
     if (node.has("scenes")) {
         // Only these scenes (labels as in "scenes"), e.g. a sweep that matters on one scene.
         const JsonNode list = node["scenes"];
@@ -540,6 +542,7 @@ std::vector<RunSpec> expandRuns(const ExperimentConfig& config) {
                     }
                 }
                 run.timedFrames = t.timedFrames;
+                run.warmupFrames = t.warmupFrames;
                 for (int r = 1; r < t.repeats; ++r) {  // after every block's first round
                     RunSpec again = run;
                     again.repeat = r;

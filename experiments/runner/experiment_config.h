@@ -76,6 +76,9 @@ struct TechniqueEntry {
     int repeats = 1;
     /** "frames": timed frames of this block's runs (0 = the config's "timing.frames"). */
     int timedFrames = 0;
+    /** "warmup": warm-up frames of this block's runs (-1 = the config's "timing.warmup"), e.g.
+     *  the updates a probe technique needs to converge before scoring. */
+    int warmupFrames = -1;
 };
 
 /** Default of "max_runs": a config whose sweeps expand to more runs is refused. */
@@ -116,6 +119,7 @@ struct RunSpec {
     std::map<std::string, std::string> swept;  // swept key -> canonical value text
     int repeat = 0;       // 0 = the first run of this configuration; r > 0: its r-th repeat
     int timedFrames = 0;  // timed frames (0 = the config's)
+    int warmupFrames = -1;  // warm-up frames (-1 = the config's)
 };
 
 /** Expands every technique block into runs (scenes outermost), validating every value.

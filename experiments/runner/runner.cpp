@@ -85,7 +85,7 @@ nlohmann::ordered_json runIdentityStatic(const ExperimentConfig& config, const R
             {"technique", run.techniqueId},
             {"params", keyParams(run.params)},
             {"shared", run.shared.toOrderedJson()},
-            {"warmup", config.timing.warmupFrames},
+            {"warmup", run.warmupFrames >= 0 ? run.warmupFrames : config.timing.warmupFrames},
             {"frames", run.timedFrames > 0 ? run.timedFrames : config.timing.timedFrames},
             {"metrics", metricsSpecJson(config.metrics)}};
 }
@@ -407,6 +407,10 @@ int timedFrames(const Context& c, const RunSpec& run) {
     return run.timedFrames > 0 ? run.timedFrames : c.config.timing.timedFrames;
 }
 
+int warmupFrames(const Context& c, const RunSpec& run) {
+    return run.warmupFrames >= 0 ? run.warmupFrames : c.config.timing.warmupFrames;
+}
+
 /** result["reference"]: the reference the run is compared with, and its preview. */
 void addReferenceBlock(Context& c, nlohmann::ordered_json& result, const RunSpec& run,
                        const ReferenceSet& refs, const MatchedReference& matched,
@@ -482,7 +486,7 @@ std::string executePathTracerRun(Context& c, const RunSpec& run, const std::stri
                  run.scene->label.c_str(), run.params.getInt("spp"));
     PtBaselineOutput pt =
         renderPtBaseline(scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
-                         uint64_t(run.params.getInt("seed")), c.config.timing.warmupFrames,
+                         uint64_t(run.params.getInt("seed")), warmupFrames(c, run),
                          timedFrames(c, run), c.cancel);
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(pt.layers, &nonFinite);
@@ -533,17 +537,16 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     const int timed = timedFrames(c, run);
     Progress progress("run " + std::to_string(position) + "/" + std::to_string(count) + " " +
                           info.id + " on " + run.scene->label,
-                      size_t(c.config.timing.warmupFrames + timed));
+                      size_t(warmupFrames(c, run) + timed));
     SetupTiming setup;
     std::vector<FrameTiming> frames;
     WarmupResult warmup;
-    const int total = c.config.timing.warmupFrames + timed;
+    const int warm = warmupFrames(c, run);
+    const int total = warm + timed;
     try {
         setup = harness->setup();
-        warmup = harness->warmUp(c.config.timing.warmupFrames, [&](int i) {
-            progress.update(size_t(std::min(i + 1, c.config.timing.warmupFrames)));
-        });
-        for (int i = c.config.timing.warmupFrames; i < total; ++i) {
+        warmup = harness->warmUp(warm, [&](int i) { progress.update(size_t(std::min(i + 1, warm))); });
+        for (int i = warm; i < total; ++i) {
             frames.push_back(harness->renderFrame());
             progress.update(size_t(i + 1));
         }
