@@ -117,8 +117,8 @@ struct RunSpec {
     ParamSet params;
     ParamSet shared;
     std::map<std::string, std::string> swept;  // swept key -> canonical value text
-    int repeat = 0;       // 0 = the first run of this configuration; r > 0: its r-th repeat
-    int timedFrames = 0;  // timed frames (0 = the config's)
+    int repeat = 0;         // 0 = the first run of this configuration; r > 0: its r-th repeat
+    int timedFrames = 0;    // timed frames (0 = the config's)
     int warmupFrames = -1;  // warm-up frames (-1 = the config's)
 };
 

@@ -484,10 +484,9 @@ std::string executePathTracerRun(Context& c, const RunSpec& run, const std::stri
     addReferenceBlock(c, result, run, refs, matched, tm);
     std::fprintf(stderr, "[gilab] run %zu/%zu %s on %s (spp %d)\n", position, count, kPathTracerId,
                  run.scene->label.c_str(), run.params.getInt("spp"));
-    PtBaselineOutput pt =
-        renderPtBaseline(scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
-                         uint64_t(run.params.getInt("seed")), warmupFrames(c, run),
-                         timedFrames(c, run), c.cancel);
+    PtBaselineOutput pt = renderPtBaseline(
+        scene, c.config.reference.settings, uint32_t(run.params.getInt("spp")),
+        uint64_t(run.params.getInt("seed")), warmupFrames(c, run), timedFrames(c, run), c.cancel);
     size_t nonFinite = 0;
     result["nonfinite"] = cli::finiteJson(pt.layers, &nonFinite);
     result["timing"] = pt.timing;
@@ -545,7 +544,8 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     const int total = warm + timed;
     try {
         setup = harness->setup();
-        warmup = harness->warmUp(warm, [&](int i) { progress.update(size_t(std::min(i + 1, warm))); });
+        warmup =
+            harness->warmUp(warm, [&](int i) { progress.update(size_t(std::min(i + 1, warm))); });
         for (int i = warm; i < total; ++i) {
             frames.push_back(harness->renderFrame());
             progress.update(size_t(i + 1));

@@ -50,6 +50,7 @@ enum Binding : uint32_t {
     kIndirect = 9,
     kBvh = 10,
     kShadow = 12,
+    kRayDirections = 16,
 };
 
 uint64_t splitmix64(uint64_t& state) {
@@ -98,6 +99,29 @@ glm::mat3 arvoRotation(float u1, float u2, float u3) {
     return householder * r;
 }
 
+glm::vec3 sphericalFibonacci(uint32_t i, uint32_t n) {
+    const double goldenMinusOne = 0.6180339887498949;
+    const double frac = double(i) * goldenMinusOne - std::floor(double(i) * goldenMinusOne);
+    const double phi = 2.0 * 3.141592653589793 * frac;
+    const double cosTheta = 1.0 - (2.0 * i + 1.0) / double(n);
+    const double sinTheta = std::sqrt(std::max(0.0, 1.0 - cosTheta * cosTheta));
+    return glm::vec3(float(std::cos(phi) * sinTheta), float(std::sin(phi) * sinTheta),
+                     float(cosTheta));
+}
+
+std::vector<glm::vec4> ddgiRayDirections(uint32_t rays, uint32_t fixedRays,
+                                         const glm::mat3& rotation) {
+    std::vector<glm::vec4> out(rays);
+    for (uint32_t r = 0; r < rays; ++r) {
+        const glm::vec3 d =
+            r < fixedRays
+                ? sphericalFibonacci(r, fixedRays)
+                : glm::normalize(rotation * sphericalFibonacci(r - fixedRays, rays - fixedRays));
+        out[r] = glm::vec4(d, 0.0f);
+    }
+    return out;
+}
+
 DdgiVolume::DdgiVolume(TechniqueContext& ctx, const DdgiSettings& s) : m_vk(ctx.vk), m_settings(s) {
     m_grid = makeDdgiGrid(ctx.scene.caps.bounds, s);
     m_rays = uint32_t(s.raysPerProbe);
@@ -139,6 +163,9 @@ DdgiVolume::DdgiVolume(TechniqueContext& ctx, const DdgiSettings& s) : m_vk(ctx.
                              vk::MemoryUsage::DeviceLocal, ctx.tag("probe_data"));
     m_uniforms = vk::Buffer(ctx.vk, sizeof(DdgiUniforms), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT,
                             vk::MemoryUsage::Upload, ctx.tag("uniforms"));
+    m_rayDirections =
+        vk::Buffer(ctx.vk, uint64_t(m_rays) * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                   vk::MemoryUsage::Upload, ctx.tag("ray_directions"));
     ctx.timeCpu("bvh_build",
                 [&] { m_bvh = std::make_unique<rt::GpuBvh>(ctx.vk, ctx.scene, ctx.tag("bvh")); });
 
@@ -155,6 +182,7 @@ DdgiVolume::DdgiVolume(TechniqueContext& ctx, const DdgiSettings& s) : m_vk(ctx.
     rt::GpuBvh::addLayoutBindings(bindings, kBvh, cs);
     for (const vk::DescriptorBinding& b : ShadowMaps::descriptorBindings(kShadow, cs))
         bindings.push_back(b);
+    bindings.push_back({kRayDirections, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, cs});
     m_setLayout = vk::DescriptorSetLayout(ctx.vk, bindings, ctx.tag("set"));
     m_set = vk::DescriptorSet(ctx.vk, m_setLayout, 0, ctx.tag("set"));
     m_set.writeUniformBuffer(kUniforms, m_uniforms);
@@ -162,6 +190,7 @@ DdgiVolume::DdgiVolume(TechniqueContext& ctx, const DdgiSettings& s) : m_vk(ctx.
     m_set.writeStorageImage(kDistance, m_distance.view());
     m_set.writeBuffer(kRays, m_probeRays);
     m_set.writeBuffer(kProbes, m_probeData);
+    m_set.writeBuffer(kRayDirections, m_rayDirections);
     GBuffer& gb = ctx.shared.gbuffer();
     m_set.writeStorageImage(kGPosition, gb.position.view());
     m_set.writeStorageImage(kGNormal, gb.normal.view());
@@ -219,7 +248,9 @@ void DdgiVolume::setFrame(const DdgiSettings& s, const DdgiFrameInputs& in) {
     u.camera = glm::vec4(in.camera, 0.0f);
     uint64_t state = (uint64_t(s.seed) << 32) ^ in.updateIndex;
     const float u1 = uniform01(state), u2 = uniform01(state), u3 = uniform01(state);
-    u.rotation = glm::mat4(arvoRotation(u1, u2, u3));
+    const glm::mat3 rotation = arvoRotation(u1, u2, u3);
+    u.rotation = glm::mat4(rotation);
+    m_rayDirections.uploadVector(ddgiRayDirections(m_rays, uint32_t(s.fixedRays()), rotation));
     u.size = glm::uvec4(m_width, m_height, s.seed, 0u);
     m_uniforms.upload(&u, sizeof(u));
 }

@@ -54,6 +54,15 @@ struct DdgiFrameInputs {
 /** Arvo's uniformly distributed random rotation from three uniforms in [0, 1). */
 glm::mat3 arvoRotation(float u1, float u2, float u3);
 
+/** Point i of the n-point spherical Fibonacci set: phi = 2 pi frac(i (Phi - 1)),
+ *  cos theta = 1 - (2 i + 1) / n (G3D, SDK; notes 005 §3.1). */
+glm::vec3 sphericalFibonacci(uint32_t i, uint32_t n);
+
+/** The directions of one update's rays: `fixedRays` un-rotated ones (a set of their own), then
+ *  the others' set rotated by `rotation`. */
+std::vector<glm::vec4> ddgiRayDirections(uint32_t rays, uint32_t fixedRays,
+                                         const glm::mat3& rotation);
+
 class DdgiVolume {
 public:
     DdgiVolume(TechniqueContext& ctx, const DdgiSettings& settings);
@@ -102,6 +111,7 @@ private:
     vk::Buffer m_probeRays;
     vk::Buffer m_probeData;
     vk::Buffer m_uniforms;
+    vk::Buffer m_rayDirections;
     vk::DescriptorSetLayout m_setLayout;
     vk::DescriptorSet m_set;
     vk::PipelineLayout m_layout;

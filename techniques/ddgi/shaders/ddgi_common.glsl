@@ -4,6 +4,7 @@
 // Set 1 (every ddgi pass; each shader declares what it uses before including this file):
 //   0 uniforms   1 irradiance atlas   2 distance atlas   3 probe rays   4 probe data
 //   5-8 G-buffer (gather)   9 indirect (gather)   10-11 BVH   12-15 pass lights (shadow set)
+//   16 this update's ray directions
 // Define DDGI_ATLAS_WRITABLE in the passes that write the atlases, DDGI_PROBES_WRITABLE in the
 // passes that write the probe data.
 #ifndef DDGI_COMMON_GLSL
@@ -24,7 +25,7 @@ layout(set = DDGI_SET, binding = 0, std140) uniform DdgiUniforms {
     vec4 thresholds;   // x irradiance, y brightness, z back-face (fixed rays), w back-face (texel)
     vec4 misc;         // x ray epsilon, y min front-face distance, z hit texture lod, w Chebyshev floor
     vec4 camera;       // xyz eye
-    mat4 rotation;     // this frame's random rotation of the ray set
+    mat4 rotation;     // this update's random rotation of the ray set (for reference)
     uvec4 size;        // x width, y height, z seed
 } ddgi;
 
@@ -93,23 +94,15 @@ ivec2 ddgiTileOrigin(uint index, uint interior) {
     return ivec2((c.x + c.y * int(ddgi.counts.x)) * tile, c.z * tile);
 }
 
-// ---- ray directions (spherical Fibonacci, notes 005 §3.1) ------------------------------------
+// ---- ray directions (notes 005 §3.1) --------------------------------------------------------
 
-vec3 ddgiSphericalFibonacci(float i, float n) {
-    const float kGoldenMinusOne = 0.61803398874989;
-    float phi = 2.0 * DDGI_PI * fract(i * kGoldenMinusOne);
-    float cosTheta = 1.0 - (2.0 * i + 1.0) / n;
-    float sinTheta = sqrt(clamp(1.0 - cosTheta * cosTheta, 0.0, 1.0));
-    return vec3(cos(phi) * sinTheta, sin(phi) * sinTheta, cosTheta);
-}
+// Ray r of every probe this update, written by the CPU each update (DdgiVolume::setFrame): the
+// fixed rays (relocation, classification) are an un-rotated spherical-Fibonacci set; the others
+// a set of their own, rotated by this update's random rotation (SDK).
+layout(set = DDGI_SET, binding = 16, std430) readonly buffer RayDirections { vec4 rayDirections[]; };
 
-// Ray r of every probe this frame: the fixed rays (relocation, classification) are an
-// un-rotated set; the others a set of their own, rotated by this frame's rotation (SDK).
 vec3 ddgiRayDirection(uint r) {
-    uint fixedRays = ddgi.texels.w;
-    if (r < fixedRays) return ddgiSphericalFibonacci(float(r), float(fixedRays));
-    vec3 d = ddgiSphericalFibonacci(float(r - fixedRays), float(ddgi.texels.z - fixedRays));
-    return normalize(mat3(ddgi.rotation) * d);
+    return rayDirections[r].xyz;
 }
 
 // ---- atlas lookups (software bilinear within a tile; the border makes it seamless) ----------

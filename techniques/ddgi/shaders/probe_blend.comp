@@ -53,7 +53,8 @@ void main() {
                 ++backFaces;
                 continue;
             }
-            float w = max(0.0, dot(t, ddgiRayDirection(r)));
+            float w = dot(t, ddgiRayDirection(r));
+            if (w <= 0.0) continue;
             sumL += w * ray.rgb;
             sumW += w;
         }
@@ -76,7 +77,9 @@ void main() {
         vec2 sum = vec2(0.0);
         float sumW = 0.0;
         for (uint r = fixedRays; r < raysPerProbe; ++r) {
-            float w = pow(max(0.0, dot(t, ddgiRayDirection(r))), s);
+            float c = dot(t, ddgiRayDirection(r));
+            if (c <= 0.0) continue;
+            float w = pow(c, s);
             float d = min(abs(probeRays[first + r].w), rMax);
             sum += w * vec2(d, d * d);
             sumW += w;

@@ -108,6 +108,27 @@ TEST(CpuDdgi, ArvoRotationIsARotation) {
     }
 }
 
+TEST(CpuDdgi, RayDirectionsAreUnitAndCoverTheSphere) {
+    const glm::mat3 rotation = arvoRotation(0.3f, 0.7f, 0.2f);
+    const std::vector<glm::vec4> d = ddgiRayDirections(256, 32, rotation);
+    ASSERT_EQ(d.size(), 256u);
+    glm::dvec3 fixedMean(0.0), mean(0.0);
+    for (uint32_t r = 0; r < 256; ++r) {
+        EXPECT_NEAR(glm::length(glm::vec3(d[r])), 1.0f, 1e-5f) << r;
+        (r < 32 ? fixedMean : mean) += glm::dvec3(glm::vec3(d[r]));
+    }
+    // Spherical Fibonacci sets are nearly balanced; the fixed ones are not rotated
+    EXPECT_LT(glm::length(fixedMean / 32.0), 0.05);
+    EXPECT_LT(glm::length(mean / 224.0), 0.02);
+    for (uint32_t r = 0; r < 32; ++r)
+        EXPECT_NEAR(glm::distance(glm::vec3(d[r]), sphericalFibonacci(r, 32)), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::distance(glm::vec3(d[32]), rotation * sphericalFibonacci(0, 224)), 0.0f,
+                1e-5f);
+    // cos theta = 1 - (2 i + 1) / n
+    EXPECT_NEAR(sphericalFibonacci(0, 4).z, 0.75f, 1e-6f);
+    EXPECT_NEAR(sphericalFibonacci(3, 4).z, -0.75f, 1e-6f);
+}
+
 TEST(CpuDdgi, ParameterErrorsNameTheKey) {
     ParamSet p = TechniqueRegistry::instance().defaultParams("ddgi");
     p.set("bounces", "0");
@@ -252,7 +273,7 @@ TEST_F(GpuDdgi, ClosedDoorKeepsTheDarkRoomDark) {
             sums[i++] = layerSum(
                 layer(converge(s, params, defaultSharedParams(), 60, nullptr), "indirect"));
         }
-        std::printf("two rooms, relocation %s: closed / open = %.4f\n", relocation,
+        std::printf("two rooms, relocation %s: closed / open = %.2e\n", relocation,
                     sums[1] / sums[0]);
         EXPECT_GT(sums[0], 0.0);
         EXPECT_LT(sums[1], 0.05 * sums[0]) << "relocation " << relocation;
