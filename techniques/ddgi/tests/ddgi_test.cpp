@@ -284,9 +284,8 @@ TEST_F(GpuDdgi, ClosedDoorKeepsTheDarkRoomDark) {
 // image is within 5 % of its converged value, judged on the indirect light of its left and right
 // halves (each within 5 % of its mean over the last 50 of 150 updates: the halves average out
 // the probes' flicker, which at a low hysteresis alone exceeds 5 % per pixel); lowering the
-// hysteresis must lower it. One bounce (no feedback), so the lag is the hysteresis's alone: with
-// feedback each update also adds a bounce and the approach is slower (techniques/ddgi/README.md,
-// "Lag").
+// hysteresis must lower it. One bounce (no feedback), so the lag is the hysteresis's alone (the
+// lag with feedback is not measured here; techniques/ddgi/README.md, "Limits").
 TEST_F(GpuDdgi, LightMoveSettlesFasterWithLowerHysteresis) {
     Scene s = loadSceneFile(std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json", "point");
     s.settings.width = 16;
@@ -302,7 +301,7 @@ TEST_F(GpuDdgi, LightMoveSettlesFasterWithLowerHysteresis) {
         params.set("probe_grid", "4");  // few probes, many rays: a low noise floor
         params.set("rays_per_probe", "512");
         params.set("relocation", "false");
-        params.set("bounces", "1");  // the hysteresis lag alone, without the slower feedback
+        params.set("bounces", "1");  // the hysteresis lag alone, without the feedback
         FrameHarness h(*m_ctx, s, "ddgi", params, defaultSharedParams());
         h.setFrameState(start);
         h.setup();
