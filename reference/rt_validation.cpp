@@ -1,5 +1,7 @@
 #include "reference/rt_validation.h"
 
+#include "core/util/random.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -17,6 +19,7 @@
 #include "core/scene/scene.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
+#include "core/util/random.h"
 
 namespace gilab::ref {
 namespace {
@@ -30,18 +33,12 @@ double secondsSince(Clock::time_point start) {
 // ---------------------------------------------------------------------------------------------
 // Deterministic random numbers: one splitmix64 stream per (seed, stream, ray index).
 
-uint64_t mix64(uint64_t z) {
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
 class Rng {
 public:
     Rng(uint64_t seed, uint64_t stream, uint64_t index)
-        : m_state(mix64(mix64(seed + 0x9e3779b97f4a7c15ull * (stream + 1)) ^ index)) {}
+        : m_state(mix64(mix64(seed + kSplitMixIncrement * (stream + 1)) ^ index)) {}
     uint64_t next() {
-        m_state += 0x9e3779b97f4a7c15ull;
+        m_state += kSplitMixIncrement;
         return mix64(m_state);
     }
     double uniform() { return double(next() >> 11) * 0x1.0p-53; }  // [0, 1)

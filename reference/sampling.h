@@ -14,25 +14,12 @@
 
 #include <glm/glm.hpp>
 
+#include "core/util/random.h"  // mix64, toUnitFloat
+
 namespace gilab::ref {
 
 inline constexpr float kPi = 3.14159265358979323846f;
 inline constexpr float kInvPi = 0.31830988618379067154f;
-
-/** 64-bit finaliser of SplitMix64 (Steele, Lea, Flood 2014; Stafford's "Mix13" constants). */
-inline uint64_t mix64(uint64_t x) {
-    x ^= x >> 30;
-    x *= 0xbf58476d1ce4e5b9ull;
-    x ^= x >> 27;
-    x *= 0x94d049bb133111ebull;
-    x ^= x >> 31;
-    return x;
-}
-
-/** The uniform float in [0, 1) made of the top 24 bits of a hash. */
-inline float toUnitFloat(uint64_t h) {
-    return float(uint32_t(h >> 40)) * 0x1p-24f;
-}
 
 constexpr uint32_t reverseBits32(uint32_t x) {
     x = __builtin_bswap32(x);

@@ -12,6 +12,7 @@
 #include "core/scene/scene.h"
 #include "core/technique/technique.h"
 #include "core/util/error.h"
+#include "core/util/random.h"
 #include "core/vk/barrier.h"
 #include "core/vk/context.h"
 
@@ -53,15 +54,9 @@ enum Binding : uint32_t {
     kRayDirections = 16,
 };
 
-uint64_t splitmix64(uint64_t& state) {
-    uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-    return z ^ (z >> 31);
-}
-
+/** The next uniform in [0, 1) of a SplitMix64 stream. */
 float uniform01(uint64_t& state) {
-    return float(splitmix64(state) >> 40) * (1.0f / 16777216.0f);
+    return toUnitFloat(mix64(state += kSplitMixIncrement));
 }
 
 }  // namespace

@@ -18,14 +18,9 @@ layout(local_size_x = 64) in;
 #include "common/lights.glsl"
 #include "common/shadow.glsl"
 #include "ddgi_common.glsl"
+#include "common/random.glsl"
 
 layout(set = DDGI_SET, binding = 3, std430) writeonly buffer ProbeRays { vec4 probeRays[]; };
-
-uint pcgHash(uint v) {
-    uint state = v * 747796405u + 2891336453u;
-    uint word = ((state >> ((state >> 28u) + 4u)) ^ state) * 277803737u;
-    return (word >> 22u) ^ word;
-}
 
 float random01(inout uint state) {
     state = pcgHash(state);

@@ -8,11 +8,7 @@
 
 layout(local_size_x = 1) in;
 
-uint pcgHash(uint v) {
-    uint s = v * 747796405u + 2891336453u;
-    uint w = ((s >> ((s >> 28u) + 4u)) ^ s) * 277803737u;
-    return (w >> 22u) ^ w;
-}
+#include "common/random.glsl"
 
 void main() {
     if (state.seeded != 0u) return;
