@@ -31,6 +31,9 @@ matplotlib.use("agg")
 from . import study as S  # noqa: E402
 from .analysis import slug  # noqa: E402
 from .data import read_json  # noqa: E402
+from .headlines import headlines  # noqa: E402
+from . import readme as R  # noqa: E402
+from . import changes as CH  # noqa: E402
 from .study_html import (md_breaks, md_cost, md_table, md_verdict, series_colors,  # noqa: E402
                          study_figure)
 
@@ -52,6 +55,13 @@ def parse_args(argv: list[str]) -> argparse.Namespace:
                    help="the Markdown file (default docs/findings.md)")
     p.add_argument("--glance", help="the at-a-glance table (default findings_glance.md next "
                    "to --out)")
+    p.add_argument("--previous", help="the previous findings page, a file or REV:path (e.g. "
+                   "HEAD:docs/findings.md): write what changed (gilab_report/changes.py)")
+    p.add_argument("--changes", help="where --previous writes (default findings_changes.md "
+                   "next to --out)")
+    p.add_argument("--readme", help="also write the glance, the headlines and the provenance "
+                   "between the findings markers of this Markdown file (the README's \"Findings "
+                   "at a glance\"; gilab_report/readme.py)")
     p.add_argument("--budgets", default=",".join(f"{b:g}" for b in S.BUDGETS_MS),
                    help="equal-time budgets, ms, comma-separated")
     p.add_argument("--allow-dirty", action="store_true",
@@ -158,9 +168,55 @@ def ladders_md(study: "S.Study") -> list[str]:
     return md + [""]
 
 
+def glance_md(study: "S.Study") -> list[str]:
+    """The at-a-glance table: per technique over the common scenes, and where it wins and
+    breaks."""
+    common = S.common_scenes(study)
+    out = [f"| technique | median best HDR-FLIP vs full reference ({len(common)} common "
+           "scenes) | error left vs direct (median, same scenes) | wins (scene: budgets, ms) "
+           "| breaks |", "|---|---|---|---|---|"]
+    for g in S.glance(study):
+        wins = "; ".join(f"{sc}: {'/'.join(b)}" for sc, b in g["wins"].items())
+        out.append(f"| {g['technique']} | {S.sig3(g['median_best'])}"
+                   + f" | {S.sig3(g['floor_ratio']) if g['floor_ratio'] is not None else '—'}"
+                   + f" | {wins or '—'} | {', '.join(g['breaks']) or '—'} |")
+    out += ["", "Common scenes (every technique has a ranked run on each): "
+            + (", ".join(common) or "none") + ". Wins: equal-time verdicts on any quality "
+            "scene, compensating runs never winning (docs/report.md, \"Verdict rules\").", ""]
+    return out
+
+
+def readme_md(study: "S.Study", glance: list[str], provenance: str, findings_path: str,
+              readme_path: str) -> list[str]:
+    """The README's generated section: the basis, the glance table, the headlines, where the
+    rest is."""
+    quality = S.quality_scenes(study)
+    link = os.path.relpath(os.path.abspath(findings_path),
+                           os.path.dirname(os.path.abspath(readme_path)))
+    return ([f"One study puts every technique on the same {len(quality)} quality scenes "
+             f"({', '.join(quality)}), each along its own quality ladder with the paper's "
+             "settings as one rung, against the equal-time path tracer on the same CPU. "
+             "**Basis**: error is HDR-FLIP against the full path-traced reference (all "
+             "bounces); the bounce-matched basis and the bounce floors are beside it in "
+             f"[{os.path.basename(link)}]({link}). Time is the static frame's GPU time (the "
+             f"moving frame on animated scenes), set-up apart. {S.DEVICE_CAVEAT[0].upper()}"
+             f"{S.DEVICE_CAVEAT[1:]}. Lower is better.", ""]
+            + glance
+            + ["\"Error left vs direct\" is the median over the common scenes of the "
+               "technique's best HDR-FLIP over `direct`'s (1 = no better than no indirect light). "
+               "What the numbers say:", ""]
+            + [f"- {line}" for line in headlines(study)]
+            + ["", provenance, "",
+               f"Every table, plot, rule and tie, the noise in each, and the where-it-breaks "
+               f"table: [{link}]({link})."])
+
+
 def write_findings(results: str, out: str, glance_path: str, audit: str | None,
                    budgets: tuple[float, ...], fractions: tuple[float, ...],
-                   argv: list[str], allow_dirty: bool = False) -> tuple[str, str, list[str]]:
+                   argv: list[str], allow_dirty: bool = False,
+                   readme: str | None = None,
+                   previous: tuple[str, str] | None = None,
+                   changes: str | None = None) -> tuple[str, str, list[str]]:
     bad: list[str] = []
     all_rows = S.load_rows([results], bad)
     for b in bad:
@@ -171,7 +227,8 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
     study = S.analyse(rows, budgets, fractions, S.load_audit(audit))
     out_dir = os.path.dirname(os.path.abspath(out))
     fig_dir = os.path.join(out_dir, "findings")
-    commit = git_commit((out, glance_path, fig_dir))
+    commit = git_commit((out, glance_path, fig_dir) + ((readme,) if readme else ())
+                        + ((changes,) if changes else ()))
     dirty = dirty_reasons(commit, study.commits)
     if dirty and not allow_dirty:
         raise DirtyError("; ".join(dirty))
@@ -188,6 +245,10 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
     if not all_rows:
         md += ["No finished runs yet.", ""]
     md += md_verdict(study)
+    md += ["## Headlines", "", "Each restates numbers of the tables below "
+           "(gilab_report/headlines.py).", ""]
+    md += [f"- {line}" for line in headlines(study)] or ["- (no ranked runs yet)"]
+    md.append("")
     md += caveats_md(study)
     md += ["## Provenance", "",
           f"- commit `{commit}` (the runs: {', '.join(study.commits) or 'unknown'})",
@@ -223,10 +284,14 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
            "Noise floors: what an image that differs from the reference by the reference's own "
            "noise would score (relMSE, HDR-FLIP); the HDR-FLIP error bar is the spread of a "
            "run's HDR-FLIP over resampled references (median over the scene's runs).", "",
+           "Bounce floors: the HDR-FLIP against the full reference of the reference's own exact "
+           "image with 0, 1 or 2 indirect bounces (its bounce layers), with its error bar: no "
+           "technique that computes that many bounces can score lower without an energy error.",
+           "",
            "| scene | reference spp | relMSE noise floor | HDR-FLIP noise floor | HDR-FLIP error "
            "bar | direct floor HDR-FLIP (time) | direct light HDR-FLIP | direct light energy | "
-           "shadow leak |",
-           "|---|---|---|---|---|---|---|---|---|"]
+           "shadow leak | bounce floors 0 / 1 / 2 bounces (±1σ) |",
+           "|---|---|---|---|---|---|---|---|---|---|"]
     for scene, st in study.scenes.items():
         f = st.direct_floor
         md.append(f"| {scene} | {_fmt_list(st.reference_spp)} | {S.sig3(st.rel_mse_noise_floor)}"
@@ -235,7 +300,10 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
                   f" | {S.sig3(f.y) + ' (' + S.ms(f.x) + ')' if f else '—'}"
                   f" | {S.sig3(st.direct_light_flip)} | {S.sig3(st.direct_light_energy)} | "
                   + (f"{S.sig3(100 * st.direct_light_leak)} %"
-                     if st.direct_light_leak is not None else "—") + " |")
+                     if st.direct_light_leak is not None else "—") + " | "
+                  + (" / ".join(f"{S.sig3(v)}" + (f" ± {S.sig3(st.bounce_floor_noise[b], 2)}"
+                                                  if b in st.bounce_floor_noise else "")
+                                for b, v in sorted(st.bounce_floors.items())) or "—") + " |")
     md.append("")
     pngs = []
     for scene, st in study.scenes.items():
@@ -271,24 +339,18 @@ def write_findings(results: str, out: str, glance_path: str, audit: str | None,
     os.makedirs(out_dir, exist_ok=True)
     with open(out, "w", encoding="utf-8") as f:
         f.write("\n".join(md))
-    common = S.common_scenes(study)
-    glance = [f"| technique | median best HDR-FLIP vs full reference ({len(common)} common "
-              "scenes) | error left vs direct (median, same scenes) | wins (scene: budgets, ms) "
-              "| breaks |", "|---|---|---|---|---|"]
-    for g in S.glance(study):
-        wins = "; ".join(f"{sc}: {'/'.join(b)}" for sc, b in g["wins"].items())
-        glance.append(f"| {g['technique']} | {S.sig3(g['median_best'])}"
-                      + f" | {S.sig3(g['floor_ratio']) if g['floor_ratio'] is not None else '—'}"
-                      + f" | {wins or '—'} | {', '.join(g['breaks']) or '—'} |")
-    glance.append("")
-    glance.append("Common scenes (every technique has a ranked run on each): "
-                  + (", ".join(common) or "none") + ". Wins: equal-time verdicts on any quality "
-                  "scene, compensating runs never winning (docs/report.md, \"Verdict rules\").")
-    glance.append("")
-    glance.append(f"Timed on {study.device}, {study.machine}; commit `{commit}`, {date}; "
-                  f"from {os.path.basename(out)} (`{command}`).")
+    glance = glance_md(study)
+    provenance = (f"Timed on {study.device}, {study.machine}; {len(all_rows)} runs of "
+                  f"`{', '.join(study.commits) or 'unknown'}`; findings from commit `{commit}`, "
+                  f"{date} (`{command}`).")
     with open(glance_path, "w", encoding="utf-8") as f:
-        f.write("\n".join(glance) + "\n")
+        f.write("\n".join(glance + [provenance]) + "\n")
+    if readme:
+        R.write(readme, "\n".join(readme_md(study, glance, provenance, out, readme)))
+    if previous and changes:
+        old = CH.parse(previous[0])
+        with open(changes, "w", encoding="utf-8") as f:
+            f.write("\n".join(CH.changes_md(old, previous[1], study, [provenance])))
     return out, glance_path, pngs
 
 
@@ -310,9 +372,22 @@ def main(argv: list[str]) -> int:
         audit = default if os.path.isfile(default) else None
     glance = args.glance or os.path.join(os.path.dirname(os.path.abspath(args.out)),
                                          "findings_glance.md")
+    previous = changes = None
+    if args.previous:
+        try:
+            previous = CH.read_previous(args.previous)  # before --out may overwrite it
+        except ValueError as e:
+            print(f"findings: {e}", file=sys.stderr)
+            return 2
+        changes = args.changes or os.path.join(os.path.dirname(os.path.abspath(args.out)),
+                                               "findings_changes.md")
     try:
         out, glance, pngs = write_findings(args.results, args.out, glance, audit, budgets,
-                                           fractions, argv, args.allow_dirty)
+                                           fractions, argv, args.allow_dirty, args.readme,
+                                           previous, changes)
+    except R.MarkerError as e:
+        print(f"findings: README not written: {e}", file=sys.stderr)
+        return 2
     except DirtyError as e:
         print(f"findings: not written: {e}. Findings are written only from a clean commit: "
               "commit (and rebuild and rerun what changed) first, or pass --allow-dirty for a "

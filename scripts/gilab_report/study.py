@@ -636,6 +636,8 @@ class SceneStudy:
     device: str
     # bounces -> HDR-FLIP of the exact image with that many bounces vs the full reference
     bounce_floors: dict[int, float] = field(default_factory=dict)
+    # bounces -> that floor's 1 sigma error bar from the reference's noise (resampled FLIP)
+    bounce_floor_noise: dict[int, float] = field(default_factory=dict)
 
     @property
     def compensating(self) -> list[Point]:
@@ -730,7 +732,10 @@ def analyse_scene(scene: str, rows: list[dict], names: dict[str, list[str]],
         device=device_name(rows),
         bounce_floors={b: v for b in FLOOR_BOUNCES
                        if (v := _median([fnum(r.get(f"floor{b}.flip")) for r in rows]))
-                       is not None})
+                       is not None},
+        bounce_floor_noise={b: v for b in FLOOR_BOUNCES
+                            if (v := _median([fnum(r.get(f"floor{b}.flip_noise"))
+                                              for r in rows])) is not None})
 
 
 # ------------------------------------------------------------------------------------------------
@@ -1235,8 +1240,10 @@ def scene_lines(study: Study) -> list[str]:
     for sc, st in quality_scenes(study).items():
         parts = []
         if st.bounce_floors:
-            parts.append("bounce floors " + ", ".join(f"{b}: {sig3(v)}" for b, v in
-                                                       sorted(st.bounce_floors.items())))
+            parts.append("bounce floors " + ", ".join(
+                f"{b}: {sig3(v)}" + (f" ± {sig3(st.bounce_floor_noise[b], 2)}"
+                                     if b in st.bounce_floor_noise else "")
+                for b, v in sorted(st.bounce_floors.items())))
         parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_error]
         parts += [f"{c.label}: {_column_words(c)}" for c in st.equal_time]
         out.append(f"{sc}: " + "; ".join(parts))

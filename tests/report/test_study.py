@@ -21,6 +21,7 @@ import matplotlib  # noqa: E402
 matplotlib.use("agg")
 from gilab_report import study as S  # noqa: E402
 from gilab_report import study_html as H  # noqa: E402
+from gilab_report import readme as R  # noqa: E402
 
 DEVICE = "llvmpipe (LLVM 15.0.6, 256 bits)"
 
@@ -365,6 +366,105 @@ class Findings(unittest.TestCase):
             self.assertIn("(0 common scenes)", glance)
             self.assertIn("| vct | — | — | box: ≤60/≤200 | — |", glance)
             self.assertIn("| topovpl | — | — | — | unsupported |", glance)
+
+    def test_readme_section_is_written_between_its_markers_only(self):
+        # issue 47: the README's glance and headlines come from the run, nothing by hand.
+        with tempfile.TemporaryDirectory() as tmp:
+            results = os.path.join(tmp, "results", "study")
+            runs = [result_json("k1", "box", "direct", 10.0, 0.8),
+                    result_json("k2", "box", "vct", 50.0, 0.5),
+                    result_json("k3", "box", "ssvp", 150.0, 0.4)]
+            for r in runs:
+                os.makedirs(os.path.join(results, "runs", r["key"]))
+                with open(os.path.join(results, "runs", r["key"], "result.json"), "w") as f:
+                    json.dump(r, f)
+            readme = os.path.join(tmp, "README.md")
+            before = "# Tool\n\n## Findings at a glance\n\n"
+            after = "\n## Next\n\nkept as written\n"
+            with open(readme, "w", encoding="utf-8") as f:
+                f.write(before + R.BEGIN + "\nold hand-written text\n" + R.END + after)
+            out = os.path.join(tmp, "docs", "findings.md")
+            args = [sys.executable, os.path.join(REPO, "scripts", "findings.py"), "--allow-dirty",
+                    results, "--out", out, "--budgets", "60,200", "--readme", readme]
+            proc = subprocess.run(args, capture_output=True, text=True, timeout=120)
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            with open(readme, encoding="utf-8") as f:
+                text = f.read()
+            self.assertTrue(text.startswith(before + R.BEGIN + "\n"), text[:200])
+            self.assertTrue(text.endswith(R.END + after), text[-200:])
+            self.assertNotIn("old hand-written text", text)
+            self.assertIn("| vct | 0.500 | 0.625 | box: ≤60 | — |", text)
+            self.assertIn("- **Within 60 ms a frame** the lowest error is vct 1 of 1 quality "
+                          "scenes.", text)
+            self.assertIn("- **Within 200 ms a frame** the lowest error is ssvp 1 of 1 quality "
+                          "scenes.", text)
+            self.assertIn("3 runs of `", text)
+            self.assertIn("[findings.md](docs/findings.md)", text)
+            with open(out, encoding="utf-8") as f:
+                self.assertIn("## Headlines", f.read())
+            # Run twice: the same section, not a second one.
+            proc = subprocess.run(args, capture_output=True, text=True, timeout=120)
+            with open(readme, encoding="utf-8") as f:
+                self.assertEqual(f.read().count(R.BEGIN), 1)
+            # No markers: nothing written, the file named, exit 2.
+            with open(readme, "w", encoding="utf-8") as f:
+                f.write("# Tool\n")
+            proc = subprocess.run(args, capture_output=True, text=True, timeout=120)
+            self.assertEqual(proc.returncode, 2)
+            self.assertIn(f"{readme}: needs exactly one", proc.stderr)
+            with open(readme, encoding="utf-8") as f:
+                self.assertEqual(f.read(), "# Tool\n")
+
+    def test_changes_list_every_changed_winner_with_measured_notes(self):
+        # issue 47: the previous page's headlines beside the new ones, with what the runs say.
+        previous = "\n".join([
+            "- commit `abc` (the runs: abc)", "## box", "",
+            "Equal time: best HDR-FLIP vs full reference (frame time) within each budget.", "",
+            "| series | ≤ 60 ms | ≤ 200 ms |", "|---|---|---|",
+            "| direct | 0.800 (10.0 ms) | 0.800 (10.0 ms) |",
+            "| vct | **0.500 (40.0 ms)** | 0.500 (40.0 ms) |",
+            "| best (and ties) | vct | vct |", "",
+            "## Findings", "",
+            "- vct on rooms_closed: leaks (HDR-FLIP vs black ≤ 0.0100, seen 4.00 % of the open "
+            "room's indirect)."])
+        with tempfile.TemporaryDirectory() as tmp:
+            results = os.path.join(tmp, "results", "study")
+            runs = [result_json("k1", "box", "direct", 12.0, 0.8),
+                    result_json("k2", "box", "vct", 80.0, 0.5),
+                    result_json("k3", "box", "ssvp", 150.0, 0.4)]
+            for r in runs:
+                os.makedirs(os.path.join(results, "runs", r["key"]))
+                with open(os.path.join(results, "runs", r["key"], "result.json"), "w") as f:
+                    json.dump(r, f)
+            old = os.path.join(tmp, "old.md")
+            with open(old, "w", encoding="utf-8") as f:
+                f.write(previous)
+            out = os.path.join(tmp, "docs", "findings.md")
+            proc = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+                                   "--allow-dirty", results, "--out", out, "--budgets", "60,200",
+                                   "--previous", old], capture_output=True, text=True,
+                                  timeout=120)
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            with open(os.path.join(tmp, "docs", "findings_changes.md"), encoding="utf-8") as f:
+                md = f.read()
+            # <= 60 ms: vct (40 ms then) has no run within it now (80 ms): direct wins.
+            self.assertIn("| box | ≤ 60 ms | vct 0.500 (40.0 ms) | direct 0.800 (12.0 ms) | cost: "
+                          "vct had 0.500 (40.0 ms) within 60 ms; now no run within it (its "
+                          "fastest: 80.0 ms); direct 0.800 (10.0 ms) → 0.800 (12.0 ms) (error "
+                          "within the noise); frame times then → now: `direct` 10.0 ms → 12.0 ms "
+                          "(×1.20) |", md)
+            # <= 200 ms: ssvp, a series the previous study did not have, wins.
+            self.assertIn("| box | ≤ 200 ms | vct 0.500 (40.0 ms) | ssvp 0.400 (150 ms) |", md)
+            self.assertIn("new series: ssvp was not in the previous study", md)
+            self.assertIn("| vct | leaks (HDR-FLIP vs black ≤ 0.0100, seen 4.00 % of the open "
+                          "room's indirect) | **not measured** |", md)
+            self.assertIn("Previous: commit `abc` (the runs: abc).", md)
+            bad = subprocess.run([sys.executable, os.path.join(REPO, "scripts", "findings.py"),
+                                  "--allow-dirty", results, "--out", out, "--previous",
+                                  os.path.join(tmp, "missing.md")], capture_output=True,
+                                 text=True, timeout=120)
+            self.assertEqual(bad.returncode, 2)
+            self.assertIn("missing.md: no such file", bad.stderr)
 
     def test_empty_folder(self):
         with tempfile.TemporaryDirectory() as tmp:
