@@ -46,6 +46,7 @@ class Old:
     provenance: list[str] = field(default_factory=list)
     scenes: dict[str, OldScene] = field(default_factory=dict)
     leaks: dict[str, tuple[bool, str]] = field(default_factory=dict)
+    corrections: list[str] = field(default_factory=list)  # its "Superseded by ..." section
 
 
 def read_previous(spec: str) -> tuple[str, str]:
@@ -73,7 +74,13 @@ def parse(text: str) -> Old:
     old = Old()
     scene: Optional[str] = None
     in_equal_time = False
+    in_corrections = False
     for line in text.split("\n"):
+        if line.startswith("## "):
+            in_corrections = line.startswith("## Superseded")
+        if in_corrections:
+            old.corrections.append(line)
+            continue
         if line.startswith("- commit ") or line.startswith("- device: ") or \
                 line.startswith("- date: ") or line.startswith("- runs: "):
             old.provenance.append(line[2:])
@@ -136,6 +143,11 @@ def _noise(p: Optional[S.Point]) -> float:
     return p.y_sigma or 0.0 if p else 0.0
 
 
+def _rounding(y: float) -> float:
+    """Half a unit of the third significant digit: the previous page's own precision."""
+    return 0.5 * 10 ** (math.floor(math.log10(abs(y))) - 2) if y else 0.0
+
+
 def cell_notes(scene: str, budget: float, col: S.Column, old: OldScene, i: int,
                st: S.SceneStudy, study: S.Study) -> list[str]:
     """What the new runs measure about one changed cell."""
@@ -161,10 +173,11 @@ def cell_notes(scene: str, budget: float, col: S.Column, old: OldScene, i: int,
                          "it" + (f" (its fastest: {S.ms(fastest)})" if fastest else ""))
         elif p is not None and then is not None:
             bar = math.sqrt(_noise(p) ** 2 + seed ** 2)
-            moved = abs(p.y - then[0]) > 2 * bar if bar else abs(p.y - then[0]) > 0.005
+            moved = abs(p.y - then[0]) > 2 * bar + _rounding(then[0])
             notes.append(f"{'error: ' if moved else ''}{who} {_fmt(then)} → {S.sig3(p.y)} "
                          f"({S.ms(p.x)})" + (" (beyond 2σ of the new error bar and seed "
-                                              "spread)" if moved else " (error within the noise)"))
+                                              "spread, and the previous page's rounding)"
+                                              if moved else " (error within the noise)"))
         elif p is not None and who not in old_series:
             notes.append(f"new series: {who} was not in the previous study")
     d = _direct_ms(old, st)
@@ -228,4 +241,9 @@ def changes_md(old: Old, where: str, study: S.Study, provenance: list[str]) -> l
         if b.series not in old.leaks and b.leak is not None:
             md.append(f"| {b.series} | not in the previous study | "
                       f"{'leaks' if b.leak else 'no leak'} ({b.leak_words}) |")
+    if old.corrections:
+        md += ["", "## The previous page's own corrections", "",
+               "Measured after its runs and before this study (quoted from the previous page; "
+               "each names the technique page that measured it):", ""]
+        md += [line for line in old.corrections[1:] if line.strip() or md[-1].strip()]
     return md + [""]
