@@ -148,13 +148,16 @@ def cost_line(study: S.Study) -> Optional[str]:
         statics = [r.static_ms for r in mine if r.static_ms is not None]
         if not setups and not lights:
             continue
+        def span(values: list[float]) -> str:
+            lo, hi = S.ms(min(values)), S.ms(max(values))
+            return lo if lo == hi else f"{lo}–{hi}"
         words = []
         if statics:
-            words.append(f"static frame {S.ms(min(statics))}–{S.ms(max(statics))}")
+            words.append(f"static frame {span(statics)}")
         if setups:
-            words.append(f"set-up {S.ms(min(setups))}–{S.ms(max(setups))}")
+            words.append(f"set-up {span(setups)}")
         if lights:
-            words.append(f"light-move frame {S.ms(min(lights))}–{S.ms(max(lights))}")
+            words.append(f"light-move frame {span(lights)}")
         parts.append(f"{tech}: " + ", ".join(words))
     if not parts:
         return None
