@@ -30,7 +30,9 @@ from typing import Optional
 from . import study as S
 
 REPO = os.path.normpath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
-CELL = re.compile(r"^\**\s*([0-9.eE+-]+)\s*\(([0-9.eE+-]+)\s*ms\)\**(?:\s*\(tie\))?\s*$")
+# A cell: '0.495 (25.3 ms)', bold when best, then marks such as '(tie)' or '(compensating)'.
+CELL = re.compile(r"^\**\s*([0-9.eE+-]+)\s*\(([0-9.eE+-]+)\s*ms\)\**(?:\s*\([a-z ]+\))*\s*$")
+MARK = re.compile(r"\s*\((?:borderline|tie|differs)\)\s*$")
 LEAK = re.compile(r"^- (.+) on (\S+): (leaks|no leak) \((.*)\)\.$")
 
 
@@ -106,20 +108,27 @@ def parse(text: str) -> Old:
         elif cols[0].startswith("---"):
             continue
         elif cols[0] == "best (and ties)":
-            st.winners = [[w.strip() for w in _split_series(c)] if c != "—" else []
-                          for c in cols[1:]]
+            st.winners = [_winners(c) for c in cols[1:]]
+        elif cols[0].startswith("best "):  # 'best on the matched basis': another basis
+            continue
         else:
             st.cells[cols[0]] = [_cell(c) for c in cols[1:]]
     return old
 
 
-def _split_series(cell: str) -> list[str]:
-    """'a (x=1, y=2), b' -> ['a (x=1, y=2)', 'b'] (commas inside parentheses kept)."""
+def _winners(cell: str) -> list[str]:
+    """'a (borderline); compensating: b' -> ['a']; 'a, b' -> ['a', 'b']; '—' -> []."""
+    head = _split_series(cell, ";")[0] if cell.strip() not in ("", "—") else ""
+    return [MARK.sub("", w) for w in _split_series(head)] if head else []
+
+
+def _split_series(cell: str, sep: str = ",") -> list[str]:
+    """'a (x=1, y=2), b' -> ['a (x=1, y=2)', 'b'] (separators inside parentheses kept)."""
     out, depth, cur = [], 0, ""
     for ch in cell:
         depth += ch == "("
         depth -= ch == ")"
-        if ch == "," and depth == 0:
+        if ch == sep and depth == 0:
             out.append(cur)
             cur = ""
         else:
@@ -140,7 +149,7 @@ def _direct_ms(old: OldScene, st: S.SceneStudy) -> Optional[str]:
 
 
 def _noise(p: Optional[S.Point]) -> float:
-    return p.y_sigma or 0.0 if p else 0.0
+    return (p.y_sigma or 0.0) if p else 0.0
 
 
 def _rounding(y: float) -> float:

@@ -95,18 +95,18 @@ def matched_line(study: S.Study) -> Optional[str]:
 def equal_error_line(study: S.Study) -> Optional[str]:
     """Who reaches the tightest equal-error target first, and how often no run reaches it."""
     reached: dict[str, int] = {}
-    none, total, target = 0, 0, None
+    none, total = 0, 0
+    target = min(study.fractions) if study.fractions else None
     for st in S.quality_scenes(study).values():
         if not st.equal_error:
             continue
         col = st.equal_error[-1]  # the tightest target
-        target = study.fractions and min(study.fractions)
         total += 1
         if col.winners:
             reached[col.winners[0]] = reached.get(col.winners[0], 0) + 1
         else:
             none += 1
-    if not total:
+    if not total or target is None:
         return None
     return (f"**At the tightest error target** ({target:g} × the direct floor's HDR-FLIP) the "
             f"fastest run is " + (_count_words(reached, total) + " scenes" if reached else "—")

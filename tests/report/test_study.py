@@ -22,6 +22,7 @@ matplotlib.use("agg")
 from gilab_report import study as S  # noqa: E402
 from gilab_report import study_html as H  # noqa: E402
 from gilab_report import readme as R  # noqa: E402
+from gilab_report import changes as CH  # noqa: E402
 
 DEVICE = "llvmpipe (LLVM 15.0.6, 256 bits)"
 
@@ -297,6 +298,14 @@ def result_json(key: str, scene: str, tech: str, x, y, status="ok", params=None,
                                    "shadow_leak": 0.001}} if y is not None else {}}
 
 
+def write_runs(results: str, runs: list[dict]) -> None:
+    """Each result.json under <results>/runs/<key>/."""
+    for r in runs:
+        os.makedirs(os.path.join(results, "runs", r["key"]))
+        with open(os.path.join(results, "runs", r["key"], "result.json"), "w") as f:
+            json.dump(r, f)
+
+
 class Findings(unittest.TestCase):
     def test_an_unreadable_run_is_named_not_silently_dropped(self):
         with tempfile.TemporaryDirectory() as tmp:
@@ -374,10 +383,7 @@ class Findings(unittest.TestCase):
             runs = [result_json("k1", "box", "direct", 10.0, 0.8),
                     result_json("k2", "box", "vct", 50.0, 0.5),
                     result_json("k3", "box", "ssvp", 150.0, 0.4)]
-            for r in runs:
-                os.makedirs(os.path.join(results, "runs", r["key"]))
-                with open(os.path.join(results, "runs", r["key"], "result.json"), "w") as f:
-                    json.dump(r, f)
+            write_runs(results, runs)
             readme = os.path.join(tmp, "README.md")
             before = "# Tool\n\n## Findings at a glance\n\n"
             after = "\n## Next\n\nkept as written\n"
@@ -415,6 +421,26 @@ class Findings(unittest.TestCase):
             with open(readme, encoding="utf-8") as f:
                 self.assertEqual(f.read(), "# Tool\n")
 
+    def test_changes_read_the_current_page_format(self):
+        # Marks in cells and in the winners' row (the page findings.py writes now) are not
+        # part of a series name; the matched-basis row is another basis, not a series.
+        old = CH.parse("\n".join([
+            "## box", "Equal time: best HDR-FLIP vs full reference.", "",
+            "| series | ≤ 50 ms | ≤ 200 ms |", "|---|---|---|",
+            "| cvgi (gather=paper) | **0.677 (33.4 ms)** | 0.677 (33.4 ms) |",
+            "| cvgi (gather=ray_weighted) | 0.495 (37.3 ms) (compensating) | 0.495 (37.3 ms) |",
+            "| vct (lift=0) | — | 0.500 (90.0 ms) (tie) |",
+            "| best (and ties) | cvgi (gather=paper) (borderline); compensating: cvgi "
+            "(gather=ray_weighted) | cvgi (gather=ray_weighted), vct (lift=0) |",
+            "| best on the matched basis | cvgi (gather=ray_weighted) (differs) | vct (lift=0) |"]))
+        box = old.scenes["box"]
+        self.assertEqual(box.budgets, [50.0, 200.0])
+        self.assertEqual(box.winners, [["cvgi (gather=paper)"],
+                                       ["cvgi (gather=ray_weighted)", "vct (lift=0)"]])
+        self.assertEqual(box.cells["cvgi (gather=ray_weighted)"], [(0.495, 37.3), (0.495, 37.3)])
+        self.assertEqual(box.cells["vct (lift=0)"], [None, (0.5, 90.0)])
+        self.assertNotIn("best on the matched basis", box.cells)
+
     def test_changes_list_every_changed_winner_with_measured_notes(self):
         # issue 47: the previous page's headlines beside the new ones, with what the runs say.
         previous = "\n".join([
@@ -432,10 +458,7 @@ class Findings(unittest.TestCase):
             runs = [result_json("k1", "box", "direct", 12.0, 0.8),
                     result_json("k2", "box", "vct", 80.0, 0.5),
                     result_json("k3", "box", "ssvp", 150.0, 0.4)]
-            for r in runs:
-                os.makedirs(os.path.join(results, "runs", r["key"]))
-                with open(os.path.join(results, "runs", r["key"], "result.json"), "w") as f:
-                    json.dump(r, f)
+            write_runs(results, runs)
             old = os.path.join(tmp, "old.md")
             with open(old, "w", encoding="utf-8") as f:
                 f.write(previous)
