@@ -2,6 +2,8 @@
 // results are kept, re-runs skip finished runs, a deleted run is redone, shards are disjoint.
 #include <unistd.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -14,6 +16,7 @@
 #include "core/scene/animation.h"
 #include "core/scene/scene_loader.h"
 #include "core/technique/frame_harness.h"
+#include "core/technique/registry.h"
 #include "core/util/error.h"
 #include "core/util/file_lock.h"
 #include "core/vk/context.h"
@@ -162,13 +165,14 @@ TEST(CpuExperimentConfig, BadConfigsNameFileAndKey) {
          },
          "more than once"},
         {"bad name", [](auto& j) { j["name"] = "a/b"; }, "name"},
-        // TechniqueInfo::checkParams: cross-parameter rules, found before anything runs.
+        // Declared rules (odd, power of two) and TechniqueInfo::checkParams's cross-parameter
+        // rules, found before anything runs.
         {"even cvgi kernel",
          [](auto& j) {
              j["techniques"][0] = {{"technique", "cvgi"},
                                    {"sweep", {{"grid", {{"gaussian_kernel", {3, 4}}}}}}};
          },
-         "gaussian_kernel = 4 must be odd"},
+         "'gaussian_kernel' must be 0 or odd in [1, 9], got 4"},
         {"vct resolution not a power of two",
          [](auto& j) {
              j["techniques"][0] = {{"technique", "vct"}, {"params", {{"voxel_resolution", 48}}}};
@@ -259,11 +263,35 @@ TEST(CpuRunStore, RowsAreAppendedAndFlattened) {
     fs::remove_all(dir);
 }
 
-TEST(CpuRunner, DryRunPrintsTheParameterColumnsOfTheResultTables) {
+/** The lines of `text`. */
+std::vector<std::string> splitLines(const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);)
+        lines.push_back(line);
+    return lines;
+}
+
+/** The tab-separated fields of `line`. */
+std::vector<std::string> splitTabs(const std::string& line) {
+    std::vector<std::string> fields;
+    size_t start = 0;
+    for (size_t tab; (tab = line.find('\t', start)) != std::string::npos; start = tab + 1)
+        fields.push_back(line.substr(start, tab - start));
+    fields.push_back(line.substr(start));
+    return fields;
+}
+
+// The dry run's table has the swept parameters as columns, right after index, key, state, scene
+// and technique; the constant ones are printed once, before it (issue 48: 37 unmarked columns).
+// A dry run writes nothing.
+TEST(CpuRunner, DryRunPutsTheSweptParametersFirstAndTheConstantsOnce) {
     const fs::path dir = tempDir("dryrun");
-    nlohmann::json j = baseConfig();
+    nlohmann::json j = baseConfig();  // direct: shared.pcf_radius 0, 1
+    j["scenes"] = {std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json#spot"};
     j["techniques"].push_back(
-        {{"technique", "vct"}, {"sweep", {{"grid", {{"voxel_resolution", {32, 64}}}}}}});
+        {{"technique", "vct"},
+         {"sweep", {{"grid", {{"diffuse_cones", {3, 6}}, {"voxel_resolution", {32, 64}}}}}}});
     const fs::path config = dir / "tiny.json";
     std::ofstream(config) << j.dump(2);
     RunnerOptions o;
@@ -272,20 +300,44 @@ TEST(CpuRunner, DryRunPrintsTheParameterColumnsOfTheResultTables) {
     o.dryRun = true;
     testing::internal::CaptureStdout();
     const RunnerSummary s = runExperiment(o, nullptr);
-    const std::string out = testing::internal::GetCapturedStdout();
-    EXPECT_EQ(s.total, 4u);
-    std::istringstream lines(out);
-    std::string header, line;
-    std::getline(lines, header);
-    for (const char* column : {"index", "key", "state", "technique", "shared.pcf_radius",
-                               "shared.area_light_samples", "param.voxel_resolution"})
-        EXPECT_NE(header.find(column), std::string::npos) << column << " in " << header;
-    int rows = 0;
-    while (std::getline(lines, line)) {
-        EXPECT_NE(line.find("[todo]"), std::string::npos) << line;
-        ++rows;
+    const std::vector<std::string> lines = splitLines(testing::internal::GetCapturedStdout());
+    EXPECT_EQ(s.total, 6u);
+    ASSERT_EQ(lines.size(), 2u + 1u + 6u);  // 2 constant lines, the header, 6 runs
+    // Constant for all runs: the shared passes' settings nobody sweeps
+    EXPECT_EQ(lines[0].rfind("# 6 runs; swept parameters are columns; constant for all runs: "
+                             "shared.shadows=true shared.shadow_resolution=1024 ",
+                             0),
+              0u)
+        << lines[0];
+    EXPECT_NE(lines[0].find(" shared.area_light_samples=16"), std::string::npos) << lines[0];
+    EXPECT_EQ(lines[0].find("pcf_radius"), std::string::npos) << lines[0];
+    // Constant for vct: its other parameters, in spec order; direct has none of its own
+    EXPECT_EQ(lines[1].rfind("# constant for vct runs: param.storage=dense "
+                             "param.octree_filter=slab param.anisotropic=true ",
+                             0),
+              0u)
+        << lines[1];
+    EXPECT_EQ(lines[1].find("diffuse_cones"), std::string::npos) << lines[1];
+    EXPECT_EQ(splitTabs(lines[2]),
+              (std::vector<std::string>{"index", "key", "state", "scene", "technique",
+                                        "param.voxel_resolution", "param.diffuse_cones",
+                                        "shared.pcf_radius"}));  // spec order, as results.csv
+    const std::vector<std::vector<std::string>> expected = {
+        {"0", "direct", "", "", "0"}, {"1", "direct", "", "", "1"}, {"2", "vct", "32", "3", "0"},
+        {"3", "vct", "64", "3", "0"}, {"4", "vct", "32", "6", "0"}, {"5", "vct", "64", "6", "0"}};
+    for (size_t i = 0; i < expected.size(); ++i) {
+        const std::vector<std::string> f = splitTabs(lines[3 + i]);
+        ASSERT_EQ(f.size(), 8u) << lines[3 + i];
+        EXPECT_EQ(f[0], expected[i][0]);
+        EXPECT_EQ(f[1].size(), 12u);
+        EXPECT_EQ(f[2], "[todo]");
+        EXPECT_EQ(f[3], "cornell_box#spot");
+        EXPECT_EQ(f[4], expected[i][1]);
+        EXPECT_EQ(f[5], expected[i][2]) << lines[3 + i];
+        EXPECT_EQ(f[6], expected[i][3]) << lines[3 + i];
+        EXPECT_EQ(f[7], expected[i][4]) << lines[3 + i];
     }
-    EXPECT_EQ(rows, 4);
+    EXPECT_FALSE(fs::exists(dir / "results")) << "a dry run wrote its results folder";
     fs::remove_all(dir);
 }
 
@@ -875,6 +927,86 @@ TEST_F(GpuRunner, AnimatedSceneRunsTheSequenceAndCachesEachReferenceFrame) {
     for (const auto& e : fs::directory_iterator(m_dir / "cache"))
         entries += e.is_directory() && e.path().filename().string()[0] != '.' ? 1 : 0;
     EXPECT_EQ(entries, distinctKeys({0, 2, 4, 6, 8}));  // 0 (= 8) and 4 reused
+}
+
+// `gilab scene-info` on the area-lit Cornell box: its emitter counts as light (it printed
+// "0 lights"), with the power pi Le A of the 13 x 10.5 cm ceiling light (Le = 17, 12, 4); the
+// camera, the file's variants and which techniques run on it, and why not (issue 48).
+TEST(CpuSceneInfo, NamesTheEmittersCameraVariantsAndTechniqueSupport) {
+    const std::string file = std::string(GILAB_SOURCE_DIR) + "/scenes/cornell_box.json";
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runSceneInfo(file, false), 0);
+    const std::string text = testing::internal::GetCapturedStdout();
+    const double area = 0.13 * 0.105;
+    char power[160];
+    std::snprintf(power, sizeof power,
+                  "  lights: 0 punctual (point, spot, directional); emissive surfaces: 2 "
+                  "triangles, %.4g m^2, power [%.4g %.4g %.4g] W\n",
+                  area, M_PI * area * 17.0, M_PI * area * 12.0, M_PI * area * 4.0);
+    for (const std::string& line : std::vector<std::string>{
+             power,
+             "  camera: position [0.278 0.273 -0.8], target [0.278 0.273 0.2], up [0 1 0], "
+             "vertical fov 39.3 deg\n",
+             "  variants: camera_dolly, point, spot, spot_corner, spot_dolly, spot_orbit "
+             "(--scene " +
+                 file + "#<variant>)\n",
+             "  techniques (default parameters):\n",
+             "    cvgi     not supported: does not support emissive surfaces as light sources",
+             "    ddgi     supported\n", "    vct      supported\n",
+             "    ssvp     not supported: needs a spot"})
+        EXPECT_NE(text.find(line), std::string::npos) << "missing \"" << line << "\" in:\n" << text;
+
+    // A variant with a spot light: the light's line, no emitters, every technique runs
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runSceneInfo(file + "#spot", false), 0);
+    const std::string spot = testing::internal::GetCapturedStdout();
+    EXPECT_NE(
+        spot.find("  lights: 1 punctual (point, spot, directional); no emissive surfaces\n"
+                  "    light 0: spot 'ceiling_spot' at [0.278 0.5388 0.2795] toward [0 -1 0]"),
+        std::string::npos)
+        << spot;
+    EXPECT_EQ(spot.find("not supported"), std::string::npos) << spot;
+
+    // --json: the same facts
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runSceneInfo(file, true), 0);
+    const nlohmann::json j = nlohmann::json::parse(testing::internal::GetCapturedStdout());
+    EXPECT_EQ(j["emissive"]["triangles"], 2);
+    EXPECT_NEAR(j["emissive"]["area_m2"].get<double>(), area, 1e-6);
+    EXPECT_NEAR(j["emissive"]["power_w"][0].get<double>(), M_PI * area * 17.0, 1e-5);
+    EXPECT_EQ(j["variants"].size(), 6u);
+    EXPECT_EQ(j["variants"][2], "spot");
+    std::map<std::string, bool> supported;
+    for (const auto& t : j["techniques"])
+        supported[t["id"]] = t["supported"];
+    EXPECT_FALSE(supported.at("cvgi"));
+    EXPECT_TRUE(supported.at("vct"));
+    EXPECT_TRUE(j["camera"].contains("vfov_deg"));
+}
+
+// `gilab list` shows every rule a parameter's value must obey, from its declaration: vct's
+// voxel_resolution is a power of two (it showed "[32, 512]" alone and failed at set-up).
+TEST(CpuList, ShowsThePowerOfTwoAndOtherRules) {
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runList(false), 0);
+    const std::string text = testing::internal::GetCapturedStdout();
+    for (const char* rule : {"power of two in [32, 512]", "0 or [8, 4096]", "0 or odd in [1, 9]",
+                             "-1 or 1", "power of two in [8, 32]",
+                             "[0, 8192]; a multiple of "
+                             "clusters"})
+        EXPECT_NE(text.find(rule), std::string::npos) << rule;
+    testing::internal::CaptureStdout();
+    EXPECT_EQ(cli::runList(true), 0);
+    const nlohmann::json j = nlohmann::json::parse(testing::internal::GetCapturedStdout());
+    for (const auto& t : j["techniques"])
+        for (const auto& p : t["params"])
+            if (t["id"] == "vct" && p["name"] == "voxel_resolution") {
+                EXPECT_EQ(p["range"], "power of two in [32, 512]");
+                EXPECT_TRUE(p["power_of_two"].get<bool>());
+            }
+    // Every power-of-two rule is in a declaration: vct refuses 48 when it is set
+    ParamSet vct = TechniqueRegistry::instance().defaultParams("vct");
+    EXPECT_THROW(vct.set("voxel_resolution", "48"), Error);
 }
 
 }  // namespace

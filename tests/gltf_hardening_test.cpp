@@ -2,6 +2,7 @@
 // and the problem (and the accessor, bufferView, node, camera, light or material), never with a
 // crash, std::bad_alloc, an out-of-range .at() or a huge allocation by a declared count.
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 
 #include "tests/temp_dir.h"
 
@@ -9,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
@@ -58,6 +60,7 @@ void operator delete[](void* p, size_t) noexcept {
 
 using namespace gilab;
 using nlohmann::json;
+namespace fs = std::filesystem;
 
 namespace {
 
@@ -732,3 +735,34 @@ TEST(CpuGltfHardening, DegenerateAndDuplicateTriangles) {
 }
 
 }  // namespace
+
+// Every file a glTF references must be a regular file: a buffer or image uri naming a folder
+// failed with a bare std::bad_alloc, a FIFO would block (issue 48).
+TEST(CpuGltfHardening, ExternalFilesMustBeRegularFiles) {
+    TempDir dir;
+    fs::create_directories(dir.path() / "folder");
+    {  // a buffer
+        Gltf g;
+        g.write(dir, "embedded.gltf");
+        g.doc["buffers"][0]["uri"] = "folder";
+        const std::string path = dir.write("buffer.gltf", g.doc.dump());
+        expectError([&] { loadGltf(path); },
+                    {path + ": the uri \"folder\" (" + (dir.path() / "folder").string() +
+                     ") is a folder, not a file"});
+    }
+    {  // an image, used or not
+        Gltf g;
+        g.doc["images"] = {{{"uri", "folder"}}};
+        const std::string path = g.write(dir, "image.gltf");
+        expectError([&] { loadGltf(path); },
+                    {path + ": the uri \"folder\"", "is a folder, not a file"});
+    }
+    {  // a FIFO
+        ASSERT_EQ(::mkfifo((dir.path() / "pipe").c_str(), 0600), 0);
+        Gltf g;
+        g.doc["images"] = {{{"uri", "pipe"}}};
+        const std::string path = g.write(dir, "fifo.gltf");
+        expectError([&] { loadGltf(path); },
+                    {path + ": the uri \"pipe\"", "is not a regular file"});
+    }
+}

@@ -27,6 +27,8 @@
 #include "core/technique/registry.h"
 #include "core/util/error.h"
 #include "core/util/json_reader.h"
+#include "core/vk/check.h"
+#include "core/vk/context.h"
 #include "experiments/cli/cli.h"
 #include "experiments/runner/experiment_config.h"
 
@@ -556,6 +558,181 @@ TEST(GpuSignals, RunStopsOnSigtermDuringAReferenceWith130AndCommitsNoRun) {
         EXPECT_TRUE(name.rfind(".tmp-", 0) == 0 || name == ".locks") << e.path();
     }
     EXPECT_FALSE(fs::exists(results / "sigterm" / "results.jsonl"));
+}
+
+// --- 6. Everyday use, round 2 (issue 48) ---------------------------------------------------
+
+struct Ran {
+    int exitCode = -1;
+    std::string output;  // stdout and stderr
+};
+
+/** Runs `command` through the shell in `dir`; returns its exit code and output. */
+Ran runIn(const fs::path& dir, const std::string& command) {
+    Ran r;
+    FILE* pipe = ::popen(("cd '" + dir.string() + "' && " + command + " 2>&1").c_str(), "r");
+    if (!pipe) return r;
+    char buffer[4096];
+    while (size_t n = std::fread(buffer, 1, sizeof buffer, pipe))
+        r.output.append(buffer, n);
+    const int status = ::pclose(pipe);
+    r.exitCode = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    return r;
+}
+
+// Hints that tell the user to run a command name the binary the way that runs it: build/gilab
+// is not on PATH (`gilab run` printed "report: gilab report ...").
+TEST(CpuHints, TheCommandInHintsIsThePathThatRuns) {
+    EXPECT_EQ(cli::runnableCommandPath("build/gilab", "/repo"), "build/gilab");
+    EXPECT_EQ(cli::runnableCommandPath("/repo/build/gilab", "/repo"), "build/gilab");
+    EXPECT_EQ(cli::runnableCommandPath("./build/../build/gilab", "/repo"), "build/gilab");
+    EXPECT_EQ(cli::runnableCommandPath("./gilab", "/repo/build"), "./gilab");
+    EXPECT_EQ(cli::runnableCommandPath("gilab", "/anywhere"), "gilab");  // found on PATH
+    EXPECT_EQ(cli::runnableCommandPath("../build/gilab", "/repo/docs"), "/repo/build/gilab");
+    EXPECT_EQ(cli::runnableCommandPath("/opt/my tools/gilab", "/home"), "'/opt/my tools/gilab'");
+    EXPECT_EQ(cli::runnableCommandPath("", "/repo"), "gilab");
+    EXPECT_EQ(cli::quoteForShell("results/it's"), "'results/it'\\''s'");
+
+    // The binary, run from its folder as ./gilab, says so in its "did you mean" hint
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    const Ran r = runIn(fs::path(gilab).parent_path(), "./gilab lsit");
+    EXPECT_EQ(r.exitCode, 2);
+    EXPECT_NE(r.output.find("did you mean 'list'?\nRun './gilab --help' for the list."),
+              std::string::npos)
+        << r.output;
+}
+
+// `gilab run`'s last line names the command that writes the report with the binary's path as
+// it was run (here bin/gilab, a link in the folder the command runs in).
+TEST(GpuRunCommand, TheReportHintUsesThePathThatRuns) {
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    TempDir dir;
+    fs::create_directories(dir.path() / "bin");
+    fs::create_symlink(gilab, dir.path() / "bin" / "gilab");
+    dir.write("hint.json", R"({
+        "name": "hint", "resolution": [16, 16], "scenes": ["builtin"],
+        "reference": {"spp": 1, "max_bounces": 0, "pixel_filter": "center"},
+        "timing": {"warmup": 0, "frames": 1},
+        "techniques": [{"technique": "direct"}]})");
+    const Ran r = runIn(dir.path(), "GILAB_CACHE=cache bin/gilab run hint.json --out res -q");
+    ASSERT_EQ(r.exitCode, 0) << r.output;
+    EXPECT_NE(r.output.find("\nreport: bin/gilab report res/hint\n"), std::string::npos)
+        << r.output;
+}
+
+// Every rule on a parameter's value (range, power of two, odd, extra values, the cross-parameter
+// rules checkParams runs at set-up) is a usage error (exit 2) found before an output folder is
+// made; `--set voxel_resolution=65` exited 1 and left an empty folder.
+TEST(CpuRenderCommand, ParameterRulesAreUsageErrorsAndLeaveNoFolder) {
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    TempDir dir;
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {"-t vct --set voxel_resolution=65",
+         "'voxel_resolution' must be a power of two in [32, 512], got 65"},
+        {"-t vct --set voxel_resolution=1024", "must be a power of two in [32, 512], got 1024"},
+        {"-t vct --set light_map_resolution=4", "must be 0 or in [8, 4096], got 4"},
+        {"-t ssvp --set second_bounce_vpls=100",
+         "second_bounce_vpls = 100 must be a multiple of clusters = 8"},
+        {"-t direct --set shared.area_light_samples=4096 --set shared.area_shadow_resolution=4096",
+         "MiB of shadow cubes"},
+        {"-t vct --set storage=sparse", "must be one of {dense, octree}"}};
+    for (const auto& [args, message] : cases) {
+        const Ran r =
+            runIn(dir.path(), gilab + " render " + args + " --resolution 16x16 -q --out out");
+        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.output;
+        EXPECT_NE(r.output.find(message), std::string::npos) << args << ": " << r.output;
+        EXPECT_FALSE(fs::exists(dir.path() / "out")) << args << " left its output folder";
+    }
+    // gilab reference: --sobol-replicate must be a power of two
+    const Ran ref = runIn(dir.path(), gilab +
+                                          " reference --sampler sobol --sobol-replicate 3 "
+                                          "--spp 4 --resolution 8x8 --no-cache --out out");
+    EXPECT_EQ(ref.exitCode, 2) << ref.output;
+    EXPECT_NE(ref.output.find("must be a power of two"), std::string::npos) << ref.output;
+    EXPECT_FALSE(fs::exists(dir.path() / "out"));
+    // gilab run: a config's bad value is refused before the experiment folder is made (a bad
+    // input file: exit 1, as every config error)
+    dir.write("bad.json", R"({
+        "name": "bad", "resolution": [16, 16], "scenes": ["builtin"],
+        "reference": {"spp": 1, "max_bounces": 0, "pixel_filter": "center"},
+        "techniques": [{"technique": "vct", "params": {"voxel_resolution": 65}}]})");
+    const Ran run = runIn(dir.path(), gilab + " run bad.json --out res -q");
+    EXPECT_EQ(run.exitCode, 1) << run.output;
+    EXPECT_NE(run.output.find("bad.json"), std::string::npos) << run.output;
+    EXPECT_NE(run.output.find("must be a power of two in [32, 512], got 65"), std::string::npos)
+        << run.output;
+    EXPECT_FALSE(fs::exists(dir.path() / "res"));
+}
+
+// An output path through a file (--out some_file/sub) is refused up front, naming the file,
+// by render, run, reference and compare (a raw filesystem error came after the work).
+TEST(CpuOutputFolders, APathThroughAFileIsRefusedNamingTheFile) {
+    TempDir dir;
+    dir.write("some_file", "x");
+    expectError([&] { cli::checkOutputFolder("--out", dir.path() / "some_file" / "sub"); },
+                {"cannot write to " + (dir.path() / "some_file" / "sub").string() +
+                 " (--out): " + (dir.path() / "some_file").string() + " is a file, not a folder"});
+    expectError([&] { cli::checkOutputFolder("--out", dir.path() / "some_file"); },
+                {"some_file is a file, not a folder"});
+    cli::checkOutputFolder("--out", dir.path() / "new" / "deeper");  // fine: made later
+    EXPECT_FALSE(fs::exists(dir.path() / "new"));
+
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    dir.write("run.json", R"({
+        "name": "cfg", "resolution": [16, 16], "scenes": ["builtin"],
+        "reference": {"spp": 1, "max_bounces": 0, "pixel_filter": "center"},
+        "techniques": [{"technique": "direct"}]})");
+    for (const std::string& args :
+         {std::string("render --resolution 8x8 --out some_file/sub"),
+          std::string("reference --spp 1 --resolution 8x8 --no-cache --out some_file/sub"),
+          std::string("run run.json --out some_file"),
+          std::string("compare a.exr b.exr --out some_file/sub")}) {
+        const Ran r = runIn(dir.path(), gilab + " " + args);
+        EXPECT_EQ(r.exitCode, 2) << args << ": " << r.output;
+        EXPECT_NE(r.output.find("some_file is a file, not a folder"), std::string::npos)
+            << args << ": " << r.output;
+    }
+}
+
+// Out of memory at set-up names the resolution, the resource and its size, and advises a smaller
+// --resolution (it printed the raw vkBindImageMemory failure).
+TEST(CpuRenderCommand, OutOfMemoryNamesTheResolutionAndTheResource) {
+    const vk::OutOfMemoryError e("binding", "image", "shared/gbuffer.position", uint64_t(4) << 30,
+                                 VK_ERROR_OUT_OF_DEVICE_MEMORY);
+    EXPECT_EQ(std::string(e.what()),
+              "binding 4294967296 bytes (4096 MiB) of memory to image 'shared/gbuffer.position' "
+              "failed: VK_ERROR_OUT_OF_DEVICE_MEMORY");
+    const std::string m = cli::describeOutOfMemory(16384, 16384, e);
+    EXPECT_EQ(m.rfind("out of memory at 16384x16384: binding 4294967296 bytes (4096 MiB)", 0), 0u)
+        << m;
+    EXPECT_NE(m.find("try a smaller --resolution (e.g. 8192x8192)"), std::string::npos) << m;
+    // A DeviceLimitError, so an experiment records the run as unsupported and goes on
+    EXPECT_NE(dynamic_cast<const DeviceLimitError*>(&e), nullptr);
+}
+
+// The render itself: lavapipe cannot bind a 16384^2 RGBA32F G-buffer image (4 GiB); a device
+// that can is skipped (it would render 16384^2).
+TEST(GpuRenderCommand, AResolutionTooLargeForTheDeviceSaysSoAndLeavesNoFolder) {
+    const std::string gilab = findGilab();
+    if (gilab.empty()) GTEST_SKIP() << "no gilab binary next to the tests";
+    {
+        vk::Context ctx;
+        if (ctx.deviceName().find("llvmpipe") == std::string::npos)
+            GTEST_SKIP() << ctx.deviceName() << " may hold 16384^2 images: not rendered";
+    }
+    TempDir dir;
+    const Ran r =
+        runIn(dir.path(), gilab + " render --resolution 16384x16384 -t direct -q --out x");
+    EXPECT_EQ(r.exitCode, 1) << r.output;
+    EXPECT_NE(r.output.find("gilab: error: out of memory at 16384x16384: "), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("try a smaller --resolution (e.g. 8192x8192)"), std::string::npos)
+        << r.output;
+    EXPECT_FALSE(fs::exists(dir.path() / "x"));
 }
 
 }  // namespace

@@ -315,6 +315,56 @@ TEST(CpuParams, InconsistentSpecsAreRejected) {
     fails({bad}, "NaN");
 }
 
+// Rules beyond the range are declared in the spec, checked by set() and shown by describe:
+// `--set voxel_resolution=65` passed the range [32, 512] and failed only at set-up (issue 48).
+TEST(CpuParams, PowerOfTwoOddExtraValuesAndCrossRulesAreDeclared) {
+    ParamSet p({requirePowerOfTwo(intParam("res", 64, 32, 512, "voxels", "grid")),
+                allowValue(0, requireOdd(intParam("kernel", 5, 1, 9, "", "width"))),
+                allowValue(-1, intParam("bounces", -1, 1, 1, "", "-1 or 1")),
+                allowValue(0, floatParam("aperture", 0.0, 1.0, 60.0, "deg", "0 = auto")),
+                addCrossRule("a multiple of c", intParam("n", 8, 0, 64, "", "count"))},
+               "t");
+    EXPECT_EQ(errorText([&] { p.set("res", "65"); }),
+              "t: parameter 'res' must be a power of two in [32, 512], got 65");
+    EXPECT_EQ(errorText([&] { p.set("res", "1024"); }),
+              "t: parameter 'res' must be a power of two in [32, 512], got 1024");
+    EXPECT_EQ(errorText([&] { p.set("res", "16"); }),
+              "t: parameter 'res' must be a power of two in [32, 512], got 16");
+    for (const char* ok : {"32", "128", "512"})
+        EXPECT_NO_THROW(p.set("res", ok)) << ok;
+    EXPECT_EQ(p.getInt("res"), 512);
+    EXPECT_EQ(errorText([&] { p.set("kernel", "4"); }),
+              "t: parameter 'kernel' must be 0 or odd in [1, 9], got 4");
+    EXPECT_THROW(p.set("kernel", "11"), Error);
+    for (const char* ok : {"0", "1", "3", "9"})
+        EXPECT_NO_THROW(p.set("kernel", ok)) << ok;
+    EXPECT_EQ(errorText([&] { p.set("bounces", "0"); }),
+              "t: parameter 'bounces' must be -1 or 1, got 0");
+    p.set("bounces", "1");
+    p.set("bounces", "-1");
+    EXPECT_EQ(errorText([&] { p.set("aperture", "0.5"); }),
+              "t: parameter 'aperture' must be 0 or in [1, 60], got 0.5");
+    p.set("aperture", "0");
+    p.set("aperture", "1");
+    // `gilab list` and --help show the same words
+    const std::vector<ParamSpec>& specs = p.specs();
+    EXPECT_EQ(describeParamRange(specs[0]), "power of two in [32, 512]");
+    EXPECT_EQ(describeParamRange(specs[1]), "0 or odd in [1, 9]");
+    EXPECT_EQ(describeParamRange(specs[2]), "-1 or 1");
+    EXPECT_EQ(describeParamRange(specs[3]), "0 or [1, 60]");
+    EXPECT_EQ(describeParamRange(specs[4]), "[0, 64]; a multiple of c");
+    EXPECT_CONTAINS(formatParamHelp(specs), "power of two in [32, 512]");
+    // The rules fit the type
+    auto fails = [](ParamSpec spec, const std::string& part) {
+        EXPECT_CONTAINS(errorText([&] { ParamSet({spec}, "t"); }), part);
+    };
+    fails(requirePowerOfTwo(floatParam("f", 1.0, 0.0, 2.0, "", "h")), "only int parameters");
+    fails(requireOdd(requirePowerOfTwo(intParam("n", 1, 1, 8, "", "h"))), "leaves only 1");
+    fails(allowValue(0.5, intParam("n", 1, 1, 8, "", "h")), "not a finite int");
+    fails(allowValue(0, boolParam("b", true, "h")), "only int and float");
+    fails(requirePowerOfTwo(intParam("n", 3, 1, 8, "", "h")), "power of two in [1, 8], got 3");
+}
+
 TEST(CpuParams, SplitAssignment) {
     EXPECT_EQ(splitAssignment("cone_count=8"),
               std::make_pair(std::string("cone_count"), std::string("8")));

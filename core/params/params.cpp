@@ -29,12 +29,19 @@ std::string inQuotes(const std::string& text) {
     return "'" + text + "'";
 }
 
-/** Empty if `v` is inside the spec's inclusive range, else the reason. */
+/** Empty if `v` is allowed (an extra value, or inside the inclusive range and obeying the
+ *  power-of-two and odd rules), else the reason. */
 std::string checkRange(const ParamSpec& spec, double v, const std::string& text) {
-    if (v >= spec.minValue && v <= spec.maxValue) return "";
-    const std::string range = describeParamRange(spec);
-    if (range.front() == '[') return "must be in " + range + ", got " + text;
-    return "must be " + range + ", got " + text;
+    for (double allowed : spec.alsoAllowed)
+        if (v == allowed) return "";
+    const bool inRange = v >= spec.minValue && v <= spec.maxValue;
+    bool rulesOk = true;
+    if (spec.powerOfTwo || spec.odd) {  // Int only (checkSpec), so v holds an int
+        const long long n = (long long)v;
+        rulesOk = spec.powerOfTwo ? n > 0 && (n & (n - 1)) == 0 : n % 2 != 0;
+    }
+    if (inRange && rulesOk) return "";
+    return "must be " + describeAllowedValues(spec) + ", got " + text;
 }
 
 Parsed parseBool(const std::string& text) {
@@ -140,6 +147,15 @@ std::string checkSpec(const ParamSpec& spec) {
     } else if (!spec.choices.empty()) {
         return "only enum parameters have choices";
     }
+    if (spec.type != ParamType::Int && (spec.powerOfTwo || spec.odd))
+        return "only int parameters can be a power of two or odd";
+    if (spec.powerOfTwo && spec.odd) return "a power of two and odd leaves only 1";
+    if (!spec.alsoAllowed.empty() && spec.type != ParamType::Int && spec.type != ParamType::Float)
+        return "only int and float parameters have extra allowed values";
+    for (double v : spec.alsoAllowed)
+        if (!std::isfinite(v) || (spec.type == ParamType::Int && v != std::floor(v)))
+            return "extra allowed value " + formatShortest(v) + " is not a finite " +
+                   paramTypeName(spec.type);
     if (spec.type == ParamType::Int) {
         for (double bound : {spec.minValue, spec.maxValue}) {
             if (std::isfinite(bound) && bound != std::floor(bound)) {

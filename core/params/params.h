@@ -36,6 +36,13 @@ struct ParamSpec {
     std::string unit;                  // e.g. "px", "deg", ""
     std::string help;                  // one line
     ParamStage stage = ParamStage::PerFrame;
+    // Further rules on the value, checked by set() and shown by `gilab list`
+    bool powerOfTwo = false;          // Int only: 1, 2, 4, ... within the range
+    bool odd = false;                 // Int only: 1, 3, 5, ... within the range
+    std::vector<double> alsoAllowed;  // Int/Float: accepted outside the range (e.g. 0 = auto)
+    /** A rule involving other parameters, in words ("a multiple of clusters"): shown by
+     *  `gilab list`, checked by the technique's TechniqueInfo::checkParams. */
+    std::string crossRule;
 };
 
 // Helpers to write spec tables tersely.
@@ -47,6 +54,12 @@ ParamSpec floatParam(std::string name, double def, double minValue, double maxVa
                      std::string unit, std::string help, ParamStage stage = ParamStage::PerFrame);
 ParamSpec enumParam(std::string name, std::string def, std::vector<std::string> choices,
                     std::string help, ParamStage stage = ParamStage::PerFrame);
+
+// Rules added to a spec: `requirePowerOfTwo(intParam(...))`, `allowValue(0, floatParam(...))`.
+ParamSpec requirePowerOfTwo(ParamSpec spec);
+ParamSpec requireOdd(ParamSpec spec);
+ParamSpec allowValue(double value, ParamSpec spec);
+ParamSpec addCrossRule(std::string rule, ParamSpec spec);
 
 /** "bool", "int", "float", "enum"; "rebuild", "per-frame". */
 const char* paramTypeName(ParamType type);
@@ -110,8 +123,12 @@ private:
 };
 
 /** Allowed values in words: "[1, 64]", ">= 0", "<= 5", "any" (Int/Float), "a|b|c" (Enum),
- *  "true|false" (Bool). */
+ *  "true|false" (Bool); with the spec's rules: "power of two in [32, 512]", "0 or [8, 4096]",
+ *  "0 or odd in [1, 9]", "-1 or 1", then "; <crossRule>" when it has one. */
 std::string describeParamRange(const ParamSpec& spec);
+/** The same as a phrase for messages ("must be ..."): "in [1, 64]", "a power of two in [32, 512]",
+ *  "0 or in [8, 4096]", ">= 0"; without the cross rule. */
+std::string describeAllowedValues(const ParamSpec& spec);
 /** Aligned table, one row per spec: name, type, default, range/choices, unit, help, stage. */
 std::string formatParamHelp(const std::vector<ParamSpec>& specs);
 /** "key=value" -> {key, value}, both trimmed; throws gilab::Error if malformed. */

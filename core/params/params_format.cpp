@@ -76,21 +76,17 @@ const char* paramStageName(ParamStage stage) {
     return stage == ParamStage::Rebuild ? "rebuild" : "per-frame";
 }
 
-std::string describeParamRange(const ParamSpec& spec) {
-    switch (spec.type) {
-        case ParamType::Bool:
-            return "true|false";
-        case ParamType::Enum:
-            return joinStrings(spec.choices, "|");
-        case ParamType::Int:
-        case ParamType::Float:
-            break;
-    }
+namespace {
+
+/** The numeric range alone: "[a, b]", "a" (a == b), ">= a", "<= b" or "any". */
+std::string rangeText(const ParamSpec& spec) {
     const bool hasMin = std::isfinite(spec.minValue);
     const bool hasMax = std::isfinite(spec.maxValue);
     // Built by appending: GCC 12 warns falsely (-Wrestrict) on "literal" + std::string&&.
     std::string out;
-    if (hasMin && hasMax) {
+    if (hasMin && hasMax && spec.minValue == spec.maxValue) {
+        out = formatShortest(spec.minValue);
+    } else if (hasMin && hasMax) {
         out.append("[").append(formatShortest(spec.minValue)).append(", ");
         out.append(formatShortest(spec.maxValue)).append("]");
     } else if (hasMin) {
@@ -101,6 +97,69 @@ std::string describeParamRange(const ParamSpec& spec) {
         out = "any";
     }
     return out;
+}
+
+/** Int/Float values in words; `sentence` reads after "must be" ("in [1, 2]", "a power of two"). */
+std::string describeNumbers(const ParamSpec& spec, bool sentence) {
+    const std::string range = rangeText(spec);
+    const bool interval = range.front() == '[';
+    const std::string rule = spec.powerOfTwo ? "power of two" : spec.odd ? "odd" : "";
+    std::string out;
+    if (rule.empty()) {
+        out = sentence && interval ? "in " + range : range;
+    } else {
+        out = sentence && spec.powerOfTwo ? "a " + rule : rule;
+        if (range != "any") out.append(interval ? " in " : " ").append(range);
+    }
+    for (auto it = spec.alsoAllowed.rbegin(); it != spec.alsoAllowed.rend(); ++it)
+        out = formatShortest(*it) + " or " + out;
+    return out;
+}
+
+}  // namespace
+
+ParamSpec requirePowerOfTwo(ParamSpec spec) {
+    spec.powerOfTwo = true;
+    return spec;
+}
+
+ParamSpec requireOdd(ParamSpec spec) {
+    spec.odd = true;
+    return spec;
+}
+
+ParamSpec allowValue(double value, ParamSpec spec) {
+    spec.alsoAllowed.push_back(value);
+    return spec;
+}
+
+ParamSpec addCrossRule(std::string rule, ParamSpec spec) {
+    spec.crossRule = std::move(rule);
+    return spec;
+}
+
+std::string describeParamRange(const ParamSpec& spec) {
+    std::string out;
+    switch (spec.type) {
+        case ParamType::Bool:
+            out = "true|false";
+            break;
+        case ParamType::Enum:
+            out = joinStrings(spec.choices, "|");
+            break;
+        case ParamType::Int:
+        case ParamType::Float:
+            out = describeNumbers(spec, false);
+            break;
+    }
+    if (!spec.crossRule.empty()) out.append("; ").append(spec.crossRule);
+    return out;
+}
+
+std::string describeAllowedValues(const ParamSpec& spec) {
+    if (spec.type == ParamType::Int || spec.type == ParamType::Float)
+        return describeNumbers(spec, true);
+    return describeParamRange(spec);
 }
 
 std::string formatParamHelp(const std::vector<ParamSpec>& specs) {

@@ -85,4 +85,23 @@ glm::vec3 meanTriangleEmission(const Scene& scene, size_t t) {
     return m.emissiveFactor * glm::vec3(sum / (double(k) * double(k)));
 }
 
+EmitterSummary computeEmitterSummary(const Scene& scene) {
+    EmitterSummary out;
+    constexpr double kPi = 3.14159265358979323846;
+    for (size_t t = 0; t < scene.triangleCount(); ++t) {
+        const Material& m = scene.materials[scene.triangleMaterials[t]];
+        if (!m.isEmissive()) continue;
+        const glm::dvec3 p0 = scene.vertices[scene.indices[3 * t]].position;
+        const glm::dvec3 p1 = scene.vertices[scene.indices[3 * t + 1]].position;
+        const glm::dvec3 p2 = scene.vertices[scene.indices[3 * t + 2]].position;
+        const double area = 0.5 * glm::length(glm::cross(p1 - p0, p2 - p0));
+        ++out.triangleCount;
+        out.areaM2 += area;
+        // Lambertian: exitance pi Le per side (docs/conventions.md)
+        out.powerW +=
+            kPi * glm::dvec3(meanTriangleEmission(scene, t)) * area * (m.doubleSided ? 2.0 : 1.0);
+    }
+    return out;
+}
+
 }  // namespace gilab

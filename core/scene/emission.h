@@ -26,4 +26,13 @@ glm::vec3 bilinearLinear(const Texture& tex, glm::vec2 uv);
  */
 glm::vec3 meanTriangleEmission(const Scene& scene, size_t t);
 
+/** The emissive triangles of a scene as a whole (`gilab scene-info`). */
+struct EmitterSummary {
+    size_t triangleCount = 0;  // triangles whose material emits
+    double areaM2 = 0.0;       // their area, one side
+    glm::dvec3 powerW{0.0};    // emitted power: sum of pi x mean Le x area x sides (1, or 2
+                               // for a double-sided material); a Lambertian emitter
+};
+EmitterSummary computeEmitterSummary(const Scene& scene);
+
 }  // namespace gilab

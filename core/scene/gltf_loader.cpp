@@ -40,6 +40,48 @@ std::string oneLine(const std::string& text) {
     return out;
 }
 
+/** The first external file (buffer or image uri) the reader below refused, and why. */
+struct RefusedFile {
+    std::string path;
+    std::string problem;
+};
+
+/**
+ * tinygltf's file reader for every file a glTF references, reading regular files only: a uri
+ * naming a folder made tinygltf's reader fail with std::bad_alloc, and a FIFO or device would
+ * never end. The first refusal is kept in `user` (a RefusedFile) for the error message.
+ */
+bool readRegularFile(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                     void* user) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    std::string problem;
+    if (fs::is_directory(status))
+        problem = "is a folder, not a file";
+    else if (!fs::exists(status))
+        problem = "does not exist";
+    else if (!fs::is_regular_file(status))
+        problem = "is not a regular file";
+    if (problem.empty()) return tinygltf::ReadWholeFile(out, err, path, nullptr);
+    auto* refused = static_cast<RefusedFile*>(user);
+    if (refused->path.empty()) *refused = {path, problem};
+    if (err) *err += problem;
+    return false;
+}
+
+/** tinygltf's FileExists by stat: its own opens the file, which blocks on a FIFO. */
+bool fileExists(const std::string& path, void*) {
+    std::error_code ec;
+    return fs::exists(path, ec);
+}
+
+/** The uri of `file` as written in a glTF in `dir` (tinygltf joins the two), for messages. */
+std::string uriOf(const fs::path& file, const fs::path& dir) {
+    if (dir.empty()) return file.string();
+    const fs::path rel = file.lexically_relative(dir);
+    return rel.empty() || *rel.begin() == ".." ? file.string() : rel.string();
+}
+
 bool hasGlbMagic(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     char magic[4] = {};
@@ -508,10 +550,25 @@ LoadResult loadFile(const std::string& path) {
 
     // Parse with tinygltf (buffers and images are read and decoded here)
     tinygltf::TinyGLTF loader;
+    RefusedFile refused;
+    tinygltf::FsCallbacks callbacks{};
+    callbacks.FileExists = &fileExists;
+    callbacks.ExpandFilePath = &tinygltf::ExpandFilePath;
+    callbacks.ReadWholeFile = &readRegularFile;
+    callbacks.WriteWholeFile = &tinygltf::WriteWholeFile;
+    callbacks.user_data = &refused;
+    loader.SetFsCallbacks(callbacks);
     tinygltf::Model model;
     std::string err, warn;
     const bool ok = hasGlbMagic(path) ? loader.LoadBinaryFromFile(&model, &err, &warn, path)
                                       : loader.LoadASCIIFromFile(&model, &err, &warn, path);
+    // A refused buffer fails the load, a refused image only warns: both are errors here
+    if (!refused.path.empty()) {
+        const std::string uri = uriOf(refused.path, fs::path(path).parent_path());
+        throw Error(path + ": the uri \"" + uri + "\"" +
+                    (uri == refused.path ? "" : " (" + refused.path + ")") + " " + refused.problem +
+                    "; a buffer's or image's uri must name a file");
+    }
     if (!ok) throw Error(path + ": malformed glTF: " + oneLine(err.empty() ? warn : err));
 
     LoadResult result;

@@ -141,6 +141,7 @@ struct Scene {
     SceneCaps caps;
     std::vector<std::string> warnings;     // e.g. "dropped 12 degenerate triangles"
     std::vector<std::string> loadedFiles;  // every file read, for provenance and cache keys
+    std::vector<std::string> variants;     // the variants its description file offers ("#spot")
 
     size_t triangleCount() const { return indices.size() / 3; }
     /** Recomputes `caps` from the data; loaders call it last. */

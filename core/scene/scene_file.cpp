@@ -234,6 +234,8 @@ Scene loadSceneFile(const std::string& pathWithVariant, const std::string& varia
                  (variant.empty() ? "" : "#" + variant);
     scene.sourcePath = path;
     scene.loadedFiles.insert(scene.loadedFiles.begin(), path);
+    for (const auto& item : variants.items())
+        scene.variants.push_back(item.key());
     scene.computeCaps();
     return scene;
 }

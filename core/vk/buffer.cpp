@@ -50,13 +50,19 @@ Buffer::Buffer(Context& ctx, VkDeviceSize size, VkBufferUsageFlags usage, Memory
         alloc.pNext = &flags;
     }
     VkResult result = vkAllocateMemory(device, &alloc, nullptr, &m_memory);
-    if (result != VK_SUCCESS) {
+    const bool allocated = result == VK_SUCCESS;
+    if (allocated) result = vkBindBufferMemory(device, m_buffer, m_memory, 0);
+    if (result != VK_SUCCESS) {  // allocation or binding refused: release both, name the buffer
+        const std::string step = allocated ? "binding" : "allocating";
+        if (allocated) vkFreeMemory(device, m_memory, nullptr);
         vkDestroyBuffer(device, m_buffer, nullptr);
-        throw Error("allocating " + std::to_string(req.size) + " bytes for buffer '" + m_name +
+        m_memory = VK_NULL_HANDLE;
+        m_buffer = VK_NULL_HANDLE;
+        if (isOutOfMemory(result)) throw OutOfMemoryError(step, "buffer", m_name, req.size, result);
+        throw Error(step + " " + std::to_string(req.size) + " bytes for buffer '" + m_name +
                     "' failed: " + resultName(result));
     }
     m_allocSize = req.size;
-    VK_CHECK(vkBindBufferMemory(device, m_buffer, m_memory, 0));
     if (mem != MemoryUsage::DeviceLocal) {
         VK_CHECK(vkMapMemory(device, m_memory, 0, VK_WHOLE_SIZE, 0, &m_mapped));
     }

@@ -1,6 +1,7 @@
 #include "core/vk/check.h"
 
 #include <string>
+#include <utility>
 
 namespace gilab::vk {
 
@@ -52,5 +53,19 @@ void throwVkError(const char* expr, VkResult result, const char* file, int line)
     throw Error(std::string(expr) + " failed: " + name + " at " + file + ":" +
                 std::to_string(line));
 }
+
+bool isOutOfMemory(VkResult result) {
+    return result == VK_ERROR_OUT_OF_DEVICE_MEMORY || result == VK_ERROR_OUT_OF_HOST_MEMORY;
+}
+
+OutOfMemoryError::OutOfMemoryError(const std::string& step, const std::string& kind,
+                                   std::string resource, uint64_t bytes, VkResult result)
+    : DeviceLimitError(step + " " + std::to_string(bytes) + " bytes (" +
+                       std::to_string(bytes >> 20) + " MiB) " +
+                       (step == "binding" ? "of memory to " : "for ") + kind + " '" + resource +
+                       "' failed: " + resultName(result)),
+      m_resource(std::move(resource)),
+      m_bytes(bytes),
+      m_result(result) {}
 
 }  // namespace gilab::vk

@@ -161,14 +161,19 @@ Image::Image(Context& ctx, const ImageDesc& desc) : m_ctx(&ctx), m_desc(desc) {
     alloc.memoryTypeIndex =
         ctx.findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
     VkResult result = vkAllocateMemory(ctx.device(), &alloc, nullptr, &m_memory);
-    if (result != VK_SUCCESS) {
+    const bool allocated = result == VK_SUCCESS;
+    if (allocated) result = vkBindImageMemory(ctx.device(), m_image, m_memory, 0);
+    if (result != VK_SUCCESS) {  // allocation or binding refused: release both, name the image
+        const std::string step = allocated ? "binding" : "allocating";
+        if (allocated) vkFreeMemory(ctx.device(), m_memory, nullptr);
         vkDestroyImage(ctx.device(), m_image, nullptr);
+        m_memory = VK_NULL_HANDLE;
         m_image = VK_NULL_HANDLE;
-        throw Error("allocating " + std::to_string(req.size) + " bytes for image '" + d.name +
+        if (isOutOfMemory(result)) throw OutOfMemoryError(step, "image", d.name, req.size, result);
+        throw Error(step + " " + std::to_string(req.size) + " bytes for image '" + d.name +
                     "' failed: " + resultName(result));
     }
     m_allocSize = req.size;
-    VK_CHECK(vkBindImageMemory(ctx.device(), m_image, m_memory, 0));
     ctx.memory().add(d.name, m_allocSize);
     ctx.setDebugName(VK_OBJECT_TYPE_IMAGE, uint64_t(m_image), d.name);
     ctx.setDebugName(VK_OBJECT_TYPE_DEVICE_MEMORY, uint64_t(m_memory), d.name);

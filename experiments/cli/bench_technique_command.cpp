@@ -41,6 +41,7 @@ void benchOne(vk::Context& ctx, const Scene& scene, const std::string& id,
     ParamSet params = TechniqueRegistry::instance().defaultParams(id);
     ParamSet shared = defaultSharedParams();
     applyAssignments(options.assignments, params, shared);
+    checkParamValues(id, params, shared);  // cross-parameter rules: exit 2
     FrameHarness harness(ctx, scene, id, params, shared);
     if (!harness.support().supported) {
         std::printf("%-8s unsupported: %s\n", id.c_str(), harness.support().reason.c_str());

@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <bit>
 #include <charconv>
 #include <cstdio>
 #include <fstream>
@@ -42,6 +43,17 @@ size_t editDistance(const std::string& a, const std::string& b) {
     return row[b.size()];
 }
 
+/** A positive integer that is a power of two (--sobol-replicate). */
+const CLI::Validator kPowerOfTwo(
+    [](std::string& text) -> std::string {
+        unsigned long long v = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
+        if (ec != std::errc() || end != text.data() + text.size() || !std::has_single_bit(v))
+            return "must be a power of two (1, 2, 4, ...), got " + text;
+        return "";
+    },
+    "POWER OF TWO");
+
 /** Every long option name ("--out") of a command. */
 std::vector<std::string> optionNames(const CLI::App* app) {
     std::vector<std::string> names;
@@ -66,8 +78,9 @@ bool printSuggestion(const CLI::App& app, int argc, char** argv) {
     if (known == commands.end()) {
         const std::string near = closestMatch(first, commands);
         std::fprintf(stderr,
-                     "gilab: error: unknown command '%s'%s\nRun 'gilab --help' for the list.\n",
-                     first.c_str(), near.empty() ? "" : ("; did you mean '" + near + "'?").c_str());
+                     "gilab: error: unknown command '%s'%s\nRun '%s --help' for the list.\n",
+                     first.c_str(), near.empty() ? "" : ("; did you mean '" + near + "'?").c_str(),
+                     runnableGilab().c_str());
         return true;
     }
     // Options of the command and of its sub-commands (bench reference, bench technique).
@@ -88,10 +101,11 @@ bool printSuggestion(const CLI::App& app, int argc, char** argv) {
         if (std::find(names.begin(), names.end(), arg) != names.end()) continue;
         const std::string near = closestMatch(arg, names);
         std::fprintf(stderr,
-                     "gilab: error: unknown option '%s' for 'gilab %s'%s\nRun 'gilab %s --help' "
+                     "gilab: error: unknown option '%s' for 'gilab %s'%s\nRun '%s %s --help' "
                      "for its options.\n",
                      arg.c_str(), where.c_str(),
-                     near.empty() ? "" : ("; did you mean '" + near + "'?").c_str(), where.c_str());
+                     near.empty() ? "" : ("; did you mean '" + near + "'?").c_str(),
+                     runnableGilab().c_str(), where.c_str());
         return true;
     }
     return false;
@@ -124,8 +138,8 @@ void checkTechniqueName(const std::string& id) {
     for (const std::string& k : ids)
         known += (known.empty() ? "" : ", ") + k;
     throw UsageError("unknown technique \"" + id + "\"" +
-                     (near.empty() ? "" : "; did you mean \"" + near + "\"?") +
-                     " (known: " + known + "; `gilab list` shows their parameters)");
+                     (near.empty() ? "" : "; did you mean \"" + near + "\"?") + " (known: " +
+                     known + "; `" + runnableGilab() + " list` shows their parameters)");
 }
 
 std::string closestMatch(const std::string& word, const std::vector<std::string>& candidates) {
@@ -142,6 +156,7 @@ std::string closestMatch(const std::string& word, const std::vector<std::string>
 }
 
 int runMain(int argc, char** argv) {
+    if (argc > 0) setInvocation(argv[0]);
     CLI::App app{
         "gilab: real-time global illumination techniques side by side on one Vulkan backend,\n"
         "measured against a path-traced ground truth."};
@@ -247,7 +262,7 @@ int runMain(int argc, char** argv) {
     ref->add_option("--sobol-replicate", reference.sobolReplicate,
                     "Sobol: samples per independently scrambled replicate, a power of two (the "
                     "replicates' spread gives the error bars)")
-        ->check(CLI::Range(1u, 1u << 30))
+        ->check(CLI::Range(1u, 1u << 30) & kPowerOfTwo)
         ->capture_default_str();
     ref->add_option("--batch", reference.batchSamples,
                     "Samples per pass (stop criteria are checked between passes; no effect on "

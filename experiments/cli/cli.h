@@ -2,6 +2,7 @@
 /** The gilab command line: `gilab --help` lists the commands. */
 #include <atomic>
 #include <cstdint>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -14,6 +15,10 @@
 #include "core/scene/scene.h"
 #include "core/util/error.h"
 #include "reference/reference_settings.h"
+
+namespace gilab::vk {
+class OutOfMemoryError;
+}
 
 namespace gilab::cli {
 
@@ -200,7 +205,28 @@ int runList(bool json);
 int runDevices(const std::string& device);
 int runSceneInfo(const std::string& scenePath, bool json);
 
-// Helpers shared by the commands
+// Helpers shared by the commands (command_checks.cpp)
+/** The shared passes' and the technique's cross-parameter checks (sharedSettingsFromParams,
+ *  TechniqueInfo::checkParams), before any work; a failure is a UsageError (exit 2). */
+void checkParamValues(const std::string& techniqueId, const ParamSet& technique,
+                      const ParamSet& shared);
+/** Throws UsageError when `dir` cannot become an output folder because it, or a folder above it,
+ *  is a file ("cannot write to a/b (--out): a is a file, not a folder"). Creates nothing. */
+void checkOutputFolder(const std::string& option, const std::filesystem::path& dir);
+/** Remembers argv[0] (runMain) for runnableGilab(). */
+void setInvocation(const std::string& argv0);
+/** How to run the binary invoked as `argv0` from `cwd`, for hints a user pastes: "gilab" when
+ *  found on PATH (no '/'), "build/gilab" when under cwd, else the absolute path; shell-quoted
+ *  when needed. */
+std::string runnableCommandPath(const std::string& argv0, const std::filesystem::path& cwd);
+/** `text` as one word for a POSIX shell: as is when safe, else in single quotes. */
+std::string quoteForShell(const std::string& text);
+/** runnableCommandPath of this process ("gilab" when setInvocation was not called). */
+std::string runnableGilab();
+/** The error of a render that ran out of memory: the resolution, the resource and its size,
+ *  and the advice to lower --resolution. */
+std::string describeOutOfMemory(int width, int height, const vk::OutOfMemoryError& e);
+
 /** Sets the scene resolution from "WxH" ("" = keep); throws gilab::Error on bad text. */
 void applyResolutionOverride(Scene& scene, const std::string& text);
 /** Writes `json` (2-space indent) to a temporary file, then renames it over `path`. */

@@ -486,6 +486,7 @@ std::pair<double, double> parseFlipExposure(const std::string& text) {
 CompareResult compareImages(const CompareOptions& options) {
     CompareResult r;
     r.selected = parseMetricNames(options.metrics);
+    if (!options.outDir.empty()) checkOutputFolder("--out", options.outDir);
     if (options.ppd < 0.0 || !std::isfinite(options.ppd)) {
         throw UsageError("--ppd: must be positive, got " + formatShortest(options.ppd));
     }

@@ -36,6 +36,10 @@ nlohmann::ordered_json specsToJson(const std::vector<ParamSpec>& specs) {
                        {"type", paramTypeName(s.type)},
                        {"default", s.defaultValue},
                        {"range", describeParamRange(s)},
+                       {"power_of_two", s.powerOfTwo},
+                       {"odd", s.odd},
+                       {"also_allowed", s.alsoAllowed},
+                       {"cross_rule", s.crossRule},
                        {"unit", s.unit},
                        {"stage", paramStageName(s.stage)},
                        {"help", s.help}});

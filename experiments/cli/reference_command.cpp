@@ -250,6 +250,7 @@ std::vector<int> parseFrameSelection(const std::string& text, int frameCount) {
 
 int runReference(const ReferenceOptions& options) {
     Progress::setQuiet(options.quiet);
+    checkOutputFolder("--out", options.outDir);  // before the render, not after it
     Scene scene = loadSceneOrDefault(options.scenePath);
     applyResolutionOverride(scene, options.resolution);
     for (const std::string& w : scene.warnings)

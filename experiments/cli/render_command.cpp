@@ -13,6 +13,7 @@
 #include "core/technique/registry.h"
 #include "core/util/error.h"
 #include "core/util/progress.h"
+#include "core/vk/check.h"
 #include "core/vk/context.h"
 #include "experiments/cli/cli.h"
 #include "experiments/runner/run_metadata.h"
@@ -94,22 +95,30 @@ int runRender(const RenderOptions& options) {
     ParamSet params = registry.defaultParams(options.technique);
     ParamSet shared = defaultSharedParams();
     applyAssignments(options.assignments, params, shared);
-    (void)sharedSettingsFromParams(shared);  // cross-parameter limits, before any GPU work
+    checkParamValues(options.technique, params, shared);  // cross-parameter rules: exit 2
 
-    vk::ContextOptions ctxOptions;
-    ctxOptions.validation = options.validation;
-    ctxOptions.deviceFilter = options.device;
-    vk::Context ctx(ctxOptions);
-
+    // The output folder is checked now and made only once there is something to write, so a
+    // refused or failed render leaves none behind.
     const std::filesystem::path outDir(
         options.outDir.empty() ? "results/render/" + options.technique : options.outDir);
+    checkOutputFolder("--out", outDir);
     const std::filesystem::path exrPath = outDir / "output.exr";
     const std::filesystem::path jsonFile = outDir / "result.json";
     if (!options.force && (std::filesystem::exists(exrPath) || std::filesystem::exists(jsonFile)))
         throw Error(outDir.string() +
                     " already holds a render (output.exr / result.json); pass --force to "
                     "overwrite it, or choose another --out");
-    std::filesystem::create_directories(outDir);
+
+    vk::ContextOptions ctxOptions;
+    ctxOptions.validation = options.validation;
+    ctxOptions.deviceFilter = options.device;
+    vk::Context ctx(ctxOptions);
+    const uint32_t maxSide = ctx.properties().limits.maxImageDimension2D;
+    if (uint32_t(scene.settings.width) > maxSide || uint32_t(scene.settings.height) > maxSide)
+        throw Error("resolution " + std::to_string(scene.settings.width) + "x" +
+                    std::to_string(scene.settings.height) + " is larger than " + ctx.deviceName() +
+                    " allows for an image (" + std::to_string(maxSide) +
+                    " pixels a side, maxImageDimension2D); give a smaller --resolution");
 
     nlohmann::ordered_json meta;
     meta["status"] = "running";
@@ -130,28 +139,35 @@ int runRender(const RenderOptions& options) {
         harness.reset();
         std::fprintf(stderr, "gilab: %s skipped on %s: %s\n", options.technique.c_str(),
                      scene.name.c_str(), meta["reason"].get<std::string>().c_str());
+        std::filesystem::create_directories(outDir);
         const std::string status = finishSidecar(ctx, meta, jsonPath, {.supported = false});
         reportValidation(meta["validation"], jsonPath);
         return exitCodeForStatus(status);
     }
 
-    Progress setupProgress("set-up " + options.technique + " on " + scene.name);
-    const SetupTiming setup = harness->setup();
-    setupProgress.finish();
-
-    const int total = options.warmupFrames + options.frames;
+    SetupTiming setup;
     std::vector<FrameTiming> frames;
-    Progress frameProgress("frames", size_t(total));
-    const WarmupResult warmup = harness->warmUp(options.warmupFrames, [&](int i) {
-        frameProgress.update(size_t(std::min(i + 1, options.warmupFrames)));
-    });
-    for (int i = options.warmupFrames; i < total; ++i) {
-        frames.push_back(harness->renderFrame());
-        frameProgress.update(size_t(i + 1));
-    }
-    frameProgress.finish();
+    WarmupResult warmup;
+    std::vector<ImageLayer> layers;
+    try {
+        Progress setupProgress("set-up " + options.technique + " on " + scene.name);
+        setup = harness->setup();
+        setupProgress.finish();
 
-    const std::vector<ImageLayer> layers = harness->readLayers();
+        const int total = options.warmupFrames + options.frames;
+        Progress frameProgress("frames", size_t(total));
+        warmup = harness->warmUp(options.warmupFrames, [&](int i) {
+            frameProgress.update(size_t(std::min(i + 1, options.warmupFrames)));
+        });
+        for (int i = options.warmupFrames; i < total; ++i) {
+            frames.push_back(harness->renderFrame());
+            frameProgress.update(size_t(i + 1));
+        }
+        frameProgress.finish();
+        layers = harness->readLayers();
+    } catch (const vk::OutOfMemoryError& e) {
+        throw Error(describeOutOfMemory(scene.settings.width, scene.settings.height, e));
+    }
     size_t nonFinite = 0;
     meta["nonfinite"] = finiteJson(layers, &nonFinite);
     meta["timing"] = timingJson(setup, frames, warmup);
@@ -163,6 +179,7 @@ int runRender(const RenderOptions& options) {
         meta["stats"][name] = value;
     harness.reset();
 
+    std::filesystem::create_directories(outDir);
     writeExrWithMainImage(exrPath.string(), layers, "final", {{kPixelFilterAttribute, "center"}});
     ToneMap tm;
     tm.exposureEv = scene.settings.exposureEv;

@@ -24,6 +24,7 @@ int runExitCode(const exp::RunnerSummary& s, bool interrupted) {
 }
 
 int runExperimentCommand(const exp::RunnerOptions& options) {
+    checkOutputFolder("--out", options.outRoot);  // the experiment's folder goes inside
     InterruptScope interrupt(
         "\ngilab: interrupted: stopping after the current run; finished runs are kept "
         "(a second Ctrl-C or SIGTERM aborts)\n");
@@ -48,7 +49,8 @@ int runExperimentCommand(const exp::RunnerOptions& options) {
                      "gilab: %zu invalid runs: Vulkan validation reported errors or warnings "
                      "(status \"invalid\" in their result.json; redone on the next run)\n",
                      s.invalid);
-    std::printf("report: gilab report %s\n", s.dir.string().c_str());
+    std::printf("report: %s report %s\n", runnableGilab().c_str(),
+                quoteForShell(s.dir.string()).c_str());
     return runExitCode(s, interrupt.interrupted());
 }
 

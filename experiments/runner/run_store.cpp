@@ -228,8 +228,12 @@ void flattenJson(const nlohmann::ordered_json& value, const std::string& prefix,
     }
 }
 
-RunStore::RunStore(fs::path experimentDir) : m_dir(std::move(experimentDir)) {
-    fs::create_directories(m_dir / "runs");
+RunStore::RunStore(fs::path experimentDir, bool create) : m_dir(std::move(experimentDir)) {
+    std::error_code ec;
+    if (fs::exists(m_dir, ec) && !fs::is_directory(m_dir, ec))
+        throw Error("cannot write the experiment's results to " + m_dir.string() + ": it is a " +
+                    "file, not a folder");
+    if (create) fs::create_directories(m_dir / "runs");
 }
 
 fs::path RunStore::runDir(const std::string& key) const {

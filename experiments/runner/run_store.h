@@ -31,7 +31,8 @@ namespace gilab::exp {
 
 class RunStore {
 public:
-    explicit RunStore(std::filesystem::path experimentDir);
+    /** Creates <experimentDir>/runs unless `create` is false (a dry run only reads). */
+    explicit RunStore(std::filesystem::path experimentDir, bool create = true);
 
     const std::filesystem::path& dir() const { return m_dir; }
     std::filesystem::path runDir(const std::string& key) const;

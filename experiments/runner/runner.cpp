@@ -23,6 +23,7 @@
 #include "core/util/json_reader.h"
 #include "core/util/progress.h"
 #include "core/vk/context.h"
+#include "experiments/runner/dry_run.h"
 #include "experiments/runner/experiment_config.h"
 #include "experiments/runner/pt_baseline.h"
 #include "experiments/runner/reference_set.h"
@@ -628,47 +629,6 @@ std::string executeRun(Context& c, const RunSpec& run, const std::string& key, s
     return commitResult(c, result, tmp, key, {.supported = true, .nonFinitePixels = nonFinite});
 }
 
-/** "[done]", "[todo]", or "[todo: invalid]" for a stored invalid run (redone). */
-const char* dryRunState(const RunStore& store, const std::string& key) {
-    const std::string status = store.storedStatus(key);
-    if (isFinalStatus(status)) return "[done]";
-    return status == "invalid" ? "[todo: invalid]" : "[todo]";
-}
-
-/** The runs as a table with the parameter columns of results.csv (param.*, shared.*). */
-void printDryRun(const std::vector<const RunSpec*>& runs, const std::vector<std::string>& keys,
-                 const RunStore& store) {
-    std::vector<std::string> columns;
-    std::vector<std::map<std::string, std::string>> cells(runs.size());
-    auto add = [&](size_t row, const std::string& column, const nlohmann::ordered_json& v) {
-        if (std::find(columns.begin(), columns.end(), column) == columns.end())
-            columns.push_back(column);
-        cells[row][column] = v.is_string() ? v.get<std::string>() : v.dump();
-    };
-    for (size_t i = 0; i < runs.size(); ++i) {
-        const nlohmann::ordered_json params = runs[i]->params.toOrderedJson();
-        const nlohmann::ordered_json shared = runs[i]->shared.toOrderedJson();
-        for (const auto& [k, v] : params.items())
-            add(i, "param." + k, v);
-        for (const auto& [k, v] : shared.items())
-            add(i, "shared." + k, v);
-    }
-    std::printf("index\tkey\tstate\tscene\ttechnique");
-    for (const std::string& c : columns)
-        std::printf("\t%s", c.c_str());
-    std::printf("\n");
-    for (size_t i = 0; i < runs.size(); ++i) {
-        std::printf("%zu\t%s\t%s\t%s\t%s", runs[i]->index, keys[i].substr(0, 12).c_str(),
-                    dryRunState(store, keys[i]), runs[i]->scene->label.c_str(),
-                    runs[i]->techniqueId.c_str());
-        for (const std::string& c : columns) {
-            auto it = cells[i].find(c);
-            std::printf("\t%s", it == cells[i].end() ? "" : it->second.c_str());
-        }
-        std::printf("\n");
-    }
-}
-
 /** --references-only: the shard's share of the config's distinct references, each obtained
  *  under the cache's lock (rendered once, whoever asks). */
 RunnerSummary renderReferences(const ExperimentConfig& config, const std::vector<RunSpec>& runs,
@@ -730,7 +690,7 @@ RunnerSummary runExperiment(const RunnerOptions& options, const std::atomic<bool
     RunnerSummary summary;
     summary.total = runs.size();
     summary.dir = fs::path(options.outRoot) / config.name;
-    RunStore store(summary.dir);
+    RunStore store(summary.dir, !options.dryRun && !options.referencesOnly);
 
     std::ifstream configIn(options.configPath);
     const std::string configText((std::istreambuf_iterator<char>(configIn)), {});

@@ -48,8 +48,9 @@ std::vector<ParamSpec> cvgiParamSpecs() {
         floatParam("near_cluster_voxels", 2.0, 0.0, 64.0, "voxels",
                    "gather a cluster voxel by voxel when its AABB is closer than this to the face "
                    "(paper: \"a given threshold\", value not given)"),
-        intParam("gaussian_kernel", 5, 0, 9, "voxels",
-                 "Gaussian kernel width, odd (paper 5; 3 evaluated); 0 or 1 = no filtering"),
+        allowValue(0, requireOdd(intParam("gaussian_kernel", 5, 1, 9, "voxels",
+                                          "Gaussian kernel width, odd: a centred kernel (paper 5; "
+                                          "3 evaluated); 0 or 1 = no filtering"))),
         intParam("gaussian_passes", 2, 0, 4, "", "Gaussian passes (paper 2)"),
         floatParam(
             "gaussian_sigma_voxels", 1.0, 0.1, 8.0, "voxels",
@@ -90,10 +91,6 @@ CvgiSettings cvgiSettingsFrom(const ParamSet& p) {
     s.interpolation = p.getBool("interpolation");
     s.gather = p.getEnum("gather") == "ray_weighted" ? CvgiSettings::Gather::RayWeighted
                                                      : CvgiSettings::Gather::Paper;
-    if (s.gaussianKernel > 1 && s.gaussianKernel % 2 == 0) {
-        throw Error("cvgi: gaussian_kernel = " + std::to_string(s.gaussianKernel) +
-                    " must be odd (a centred kernel: 3, 5, 7, 9), or 0 / 1 for no filtering");
-    }
     return s;
 }
 

@@ -18,19 +18,21 @@ std::vector<ParamSpec> ddgiParamSpecs() {
                  "probes along the volume's longest axis; the other axes get the same spacing "
                  "(at least 2 probes each). G3D default volume 8x4x8",
                  kRebuild),
-        intParam("probes_x", 0, 0, 64, "probes",
-                 "explicit probe count along x (0 = from probe_grid)", kRebuild),
-        intParam("probes_y", 0, 0, 64, "probes",
-                 "explicit probe count along y (0 = from probe_grid)", kRebuild),
-        intParam("probes_z", 0, 0, 64, "probes",
-                 "explicit probe count along z (0 = from probe_grid)", kRebuild),
+        allowValue(0, intParam("probes_x", 0, 2, 64, "probes",
+                               "explicit probe count along x (0 = from probe_grid)", kRebuild)),
+        allowValue(0, intParam("probes_y", 0, 2, 64, "probes",
+                               "explicit probe count along y (0 = from probe_grid)", kRebuild)),
+        allowValue(0, intParam("probes_z", 0, 2, 64, "probes",
+                               "explicit probe count along z (0 = from probe_grid)", kRebuild)),
         floatParam("volume_scale", 0.9, 0.5, 2.0, "",
                    "probe volume = the scene bounds scaled about their centre (G3D: inscribed 0.9, "
                    "circumscribed 1.05; techniques/ddgi/README.md)",
                    kRebuild),
-        intParam("rays_per_probe", 256, 8, 1024, "rays",
-                 "rays per probe per frame (G3D 2020 and SDK 256; blog 192; paper-era code 64)",
-                 kRebuild),
+        addCrossRule("at least 40 with relocation or classification",
+                     intParam("rays_per_probe", 256, 8, 1024, "rays",
+                              "rays per probe per frame (G3D 2020 and SDK 256; blog 192; "
+                              "paper-era code 64)",
+                              kRebuild)),
         intParam("irradiance_texels", 6, 2, 16, "texels",
                  "interior octahedral irradiance texels per side, plus a 1-texel border (SDK 6; "
                  "paper 1 and G3D 8)",
@@ -63,9 +65,10 @@ std::vector<ParamSpec> ddgiParamSpecs() {
         floatParam("view_bias", 0.1, 0.0, 10.0, "m", "b_v of the normal_view bias (SDK 0.1)"),
         floatParam("chebyshev_floor", 0.05, 0.0, 1.0, "",
                    "lower bound of the Chebyshev visibility weight (SDK 0.05; paper-era code 0)"),
-        intParam("bounces", -1, -1, 1, "",
-                 "-1 = unbounded bounces by feeding the previous irradiance to the probe-ray hits "
-                 "(the paper); 1 = probe-ray hits see direct light only"),
+        allowValue(-1, intParam("bounces", -1, 1, 1, "",
+                                "-1 = unbounded bounces by feeding the previous irradiance to "
+                                "the probe-ray hits (the paper); 1 = probe-ray hits see direct "
+                                "light only")),
         boolParam("emission_in_probes", false,
                   "add the emission of surfaces the probe rays hit (the papers); off by default "
                   "because the shared direct layer already carries emitters' direct light "
@@ -110,10 +113,6 @@ DdgiSettings ddgiSettingsFrom(const ParamSet& p) {
     DdgiSettings s;
     s.probeGrid = p.getInt("probe_grid");
     s.probeCounts = glm::ivec3(p.getInt("probes_x"), p.getInt("probes_y"), p.getInt("probes_z"));
-    for (int a = 0; a < 3; ++a)
-        if (s.probeCounts[a] == 1)
-            throw Error("ddgi: probes_" + std::string(1, "xyz"[a]) +
-                        " = 1: a probe axis needs 0 (from probe_grid) or at least 2 probes");
     s.volumeScale = p.getFloat("volume_scale");
     s.raysPerProbe = p.getInt("rays_per_probe");
     s.irradianceTexels = p.getInt("irradiance_texels");
@@ -134,12 +133,7 @@ DdgiSettings ddgiSettingsFrom(const ParamSet& p) {
     s.normalBias = p.getFloat("normal_bias");
     s.viewBias = p.getFloat("view_bias");
     s.chebyshevFloor = p.getFloat("chebyshev_floor");
-    const int bounces = p.getInt("bounces");
-    if (bounces == 0)
-        throw Error(
-            "ddgi: bounces = 0 is not a choice: -1 (unbounded by feedback, the paper) or "
-            "1 (direct light at the probe-ray hits only)");
-    s.feedback = bounces < 0;
+    s.feedback = p.getInt("bounces") < 0;
     s.emissionInProbes = p.getBool("emission_in_probes");
     s.hitLightSamples = p.getInt("hit_light_samples");
     s.hitTextureLod = p.getFloat("hit_texture_lod");

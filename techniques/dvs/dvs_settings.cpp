@@ -17,8 +17,11 @@ constexpr ParamStage kRebuild = ParamStage::Rebuild;
 std::vector<ParamSpec> dvsParamSpecs() {
     return {
         // Set-up: voxelization + per-voxel lighting (re-run by the source when lights change).
-        intParam("voxel_resolution", 128, VoxelGrid::kMinResolution, VoxelGrid::kMaxResolution,
-                 "voxels", "voxels per grid axis N (source repo default 256)", kRebuild),
+        requirePowerOfTwo(intParam("voxel_resolution", 128, VoxelGrid::kMinResolution,
+                                   VoxelGrid::kMaxResolution, "voxels",
+                                   "voxels per grid axis N (source repo default 256); a power of "
+                                   "two (the directional mips halve it down to 1)",
+                                   kRebuild)),
         enumParam("voxel_lambert", "normal_weighted", {"normal_weighted", "cosine"},
                   "per-voxel diffuse term: normal_weighted = the paper's per-axis weighting "
                   "(techniques/dvs/README.md) | cosine = plain max(N.Psi, 0)",
@@ -36,8 +39,9 @@ std::vector<ParamSpec> dvsParamSpecs() {
         floatParam("diffuse_aperture_deg", 60.0, 5.0, 120.0, "deg",
                    "full aperture of each diffuse cone (source 60)"),
         boolParam("specular", true, "indirect specular cone on glossy pixels"),
-        floatParam("specular_aperture_deg", 0.0, 0.0, 60.0, "deg",
-                   "specular cone aperture; 0 = from roughness (half-power), source test 10"),
+        allowValue(0, floatParam("specular_aperture_deg", 0.0, 1.0, 60.0, "deg",
+                                 "specular cone aperture; 0 = from roughness (half-power), source "
+                                 "test 10 (narrower than 1 deg needs sub-voxel steps)")),
         enumParam("pixel_shadows", "shared", {"shared", "cone"},
                   "direct-light shadows: keep the shared layer | recompute with a shadow cone"),
         floatParam("shadow_cone_aperture_deg", 5.0, 0.5, 60.0, "deg",
@@ -67,10 +71,6 @@ std::vector<ParamSpec> dvsParamSpecs() {
 DvsSettings dvsSettingsFrom(const ParamSet& p) {
     DvsSettings s;
     s.voxelResolution = uint32_t(p.getInt("voxel_resolution"));
-    if ((s.voxelResolution & (s.voxelResolution - 1)) != 0) {
-        throw Error("dvs: voxel_resolution = " + std::to_string(s.voxelResolution) +
-                    " must be a power of two (the directional mips halve it down to 1)");
-    }
     s.lambert =
         p.getEnum("voxel_lambert") == "cosine" ? DvsLambert::Cosine : DvsLambert::NormalWeighted;
     const std::string shadows = p.getEnum("voxel_shadows");
@@ -83,11 +83,6 @@ DvsSettings dvsSettingsFrom(const ParamSet& p) {
     s.diffuseApertureDeg = p.getFloat("diffuse_aperture_deg");
     s.specular = p.getBool("specular");
     s.specularApertureDeg = p.getFloat("specular_aperture_deg");
-    if (s.specularApertureDeg > 0.0f && s.specularApertureDeg < 1.0f) {
-        throw Error("dvs: specular_aperture_deg = " + p.getText("specular_aperture_deg") +
-                    " must be 0 (from roughness) or in [1, 60] deg (narrower cones need "
-                    "sub-voxel steps)");
-    }
     s.pixelShadows =
         p.getEnum("pixel_shadows") == "cone" ? DvsPixelShadows::Cone : DvsPixelShadows::Shared;
     s.shadowConeApertureDeg = p.getFloat("shadow_cone_aperture_deg");

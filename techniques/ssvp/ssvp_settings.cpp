@@ -14,16 +14,21 @@ constexpr double kMaxMapMiB = 4096.0;  // as the shared shadow cubes (core/techn
 
 std::vector<ParamSpec> ssvpParamSpecs() {
     return {
-        intParam("first_bounce_vpls", 256, 1, 4096, "",
-                 "N1 first-bounce VPLs from the RSM, Hammersley pattern (paper 256)", kRebuild),
-        intParam("second_bounce_vpls", 256, 0, 8192, "",
-                 "N2 second-bounce VPLs in all, N2 / C per cluster (paper 64, 256, 1024)",
-                 kRebuild),
+        addCrossRule("at least clusters",
+                     intParam("first_bounce_vpls", 256, 1, 4096, "",
+                              "N1 first-bounce VPLs from the RSM, Hammersley pattern (paper 256)",
+                              kRebuild)),
+        addCrossRule("a multiple of clusters",
+                     intParam("second_bounce_vpls", 256, 0, 8192, "",
+                              "N2 second-bounce VPLs in all, N2 / C per cluster (paper 64, 256, "
+                              "1024)",
+                              kRebuild)),
         intParam("clusters", 8, 1, 64, "",
                  "C K-means clusters = paraboloid maps (paper 4, 8, 16, 32; 8 recommended)",
                  kRebuild),
-        intParam("paraboloid_resolution", 256, 16, 2048, "texels",
-                 "paraboloid map side (paper 256; authors' code 1024)", kRebuild),
+        addCrossRule("maps x side^2 x 36 bytes <= 4096 MiB",
+                     intParam("paraboloid_resolution", 256, 16, 2048, "texels",
+                              "paraboloid map side (paper 256; authors' code 1024)", kRebuild)),
         intParam("rsm_resolution", 512, 16, 4096, "texels",
                  "reflective shadow map side (not given; authors' code 2048)", kRebuild),
         intParam("kmeans_seed", 1, 0, 1000000000, "",
@@ -80,11 +85,13 @@ std::vector<ParamSpec> ssvpParamSpecs() {
                   "the nearest first-bounce cluster) | own_maps (ours: K-means over the "
                   "second-bounce VPLs, one paraboloid map per cluster, Dong et al.'s clustered "
                   "visibility as for the first bounce)"),
-        intParam("second_bounce_clusters", 32, 1, 64, "",
-                 "C2 clusters and maps of the second-bounce VPLs (second_bounce_visibility = "
-                 "own_maps only; ours; 32 keeps 0.86-1.05 of the exact second bounce on Sponza "
-                 "and the Cornell box, 8 only 0.58 on Sponza)",
-                 kRebuild),
+        addCrossRule("at most second_bounce_vpls (with own_maps)",
+                     intParam("second_bounce_clusters", 32, 1, 64, "",
+                              "C2 clusters and maps of the second-bounce VPLs "
+                              "(second_bounce_visibility = own_maps only; ours; 32 keeps "
+                              "0.86-1.05 of the exact second bounce on Sponza and the Cornell "
+                              "box, 8 only 0.58 on Sponza)",
+                              kRebuild)),
     };
 }
 

@@ -49,9 +49,11 @@ std::vector<ParamSpec> topovplParamSpecs() {
         enumParam("topology_cache", "on", {"on", "off"},
                   "reuse the precomputed topology from results/cache/topology ($GILAB_CACHE)",
                   kRebuild),
-        intParam("vpls", 1024, 1, 65536, "",
-                 "VPLs from the reflective shadow map (paper 512, 1024, 2048; 4192 Sibenik)",
-                 kRebuild),
+        addCrossRule("at most rsm_resolution^2",
+                     intParam("vpls", 1024, 1, 65536, "",
+                              "VPLs from the reflective shadow map (paper 512, 1024, 2048; 4192 "
+                              "Sibenik)",
+                              kRebuild)),
         intParam("seed", 0, 0, 1000000000, "",
                  "VPL pattern: Cranley-Patterson shift of the Hammersley points the VPLs read "
                  "the RSM at (an offset hashed from the seed); 0 = the unshifted points (the "
@@ -66,8 +68,9 @@ std::vector<ParamSpec> topovplParamSpecs() {
                  "light-assignment entry buffer (8 bytes an entry); overflow is counted and "
                  "reported",
                  kRebuild),
-        intParam("tile_size", 32, 8, 32, "pixels",
-                 "clustered-shading tile side: 8, 16 or 32 (not given; Olsson et al. 32)"),
+        requirePowerOfTwo(intParam("tile_size", 32, 8, 32, "pixels",
+                                   "clustered-shading tile side: 8, 16 or 32, one power-of-two "
+                                   "tile in shared memory (not given; Olsson et al. 32)")),
         intParam("depth_slices", 16, 1, 64, "", "exponential depth slices (not given)"),
         floatParam("clamp_distance", 0.01, 0.0, 1.0, "scene diagonals",
                    "near-VPL clamp: 1/d^2 uses max(d, this); 0 = no clamp (the paper has none)"),
@@ -123,10 +126,6 @@ TopovplSettings topovplSettingsFrom(const ParamSet& p) {
                                     : GateRadiusRule::Max;
     s.gateRadiusScale = float(p.getFloat("gate_radius_scale"));
     s.sameClusterStat = p.getEnum("same_cluster_stat") == "on";
-    if (s.tileSize != 8 && s.tileSize != 16 && s.tileSize != 32)
-        throw Error("topovpl: tile_size = " + std::to_string(s.tileSize) +
-                    " must be 8, 16 or 32 (the local sort holds one power-of-two tile in "
-                    "shared memory)");
     if (uint64_t(s.rsmResolution) * s.rsmResolution < s.vpls)
         throw Error("topovpl: vpls = " + std::to_string(s.vpls) + " exceeds the " +
                     std::to_string(s.rsmResolution) + "^2 texels of rsm_resolution");

@@ -62,20 +62,6 @@ std::vector<vk::DescriptorBinding> toBindings(const std::vector<VkDescriptorSetL
     return out;
 }
 
-/** The cross-parameter checks of vct (TechniqueInfo::checkParams). */
-void checkVctParams(const ParamSet& p) {
-    const uint32_t n = uint32_t(p.getInt("voxel_resolution"));
-    if ((n & (n - 1)) != 0) {
-        throw Error("vct: voxel_resolution = " + std::to_string(n) +
-                    " must be a power of two (mip pyramid / octree levels)");
-    }
-    const int mapRes = p.getInt("light_map_resolution");
-    if (mapRes != 0 && mapRes < 8) {
-        throw Error("vct: light_map_resolution = " + std::to_string(mapRes) +
-                    " must be 0 (auto) or >= 8");
-    }
-}
-
 }  // namespace
 
 VctTechnique::VctTechnique() = default;
@@ -97,9 +83,11 @@ TechniqueInfo VctTechnique::describe() {
     info.supports.emissiveSurfaces = true;  // emitter samples injected through hemicube maps
     const ParamStage rebuild = ParamStage::Rebuild;
     info.params = {
-        intParam("voxel_resolution", 128, 32, 512, "voxels",
-                 "voxels per grid axis (paper: 512^3 = 9 octree levels; 128 fits lavapipe)",
-                 rebuild),
+        requirePowerOfTwo(intParam(
+            "voxel_resolution", 128, 32, 512, "voxels",
+            "voxels per grid axis (paper: 512^3 = 9 octree levels; 128 fits lavapipe); a power "
+            "of two (mip pyramid / octree levels)",
+            rebuild)),
         enumParam("storage", "dense", {"dense", "octree"},
                   "radiance storage: dense 3D textures with mips, or the paper's sparse voxel "
                   "octree with 3^3 bricks",
@@ -113,10 +101,11 @@ TechniqueInfo VctTechnique::describe() {
                   "6 directional mip volumes (dense) or directional bricks above the leaves "
                   "(octree) (Crassin §9); off = isotropic mips with the 3^3 Gaussian filter",
                   rebuild),
-        intParam("light_map_resolution", 0, 0, 4096, "texels",
-                 "light-view map side per light view (0 = auto: texel footprint <= v0/2 on the "
-                 "farthest grid corner, the paper's rule; clamped to the device limits)",
-                 rebuild),
+        allowValue(0, intParam("light_map_resolution", 0, 8, 4096, "texels",
+                               "light-view map side per light view (0 = auto: texel footprint <= "
+                               "v0/2 on the farthest grid corner, the paper's rule; clamped to "
+                               "the device limits)",
+                               rebuild)),
         intParam("diffuse_cones", 6, 1, 16, "",
                  "diffuse cones: one along the normal + a ring (paper timings: 3)"),
         floatParam("diffuse_aperture_deg", 60.0, 1.0, 179.0, "deg",
@@ -166,13 +155,11 @@ TechniqueInfo VctTechnique::describe() {
         floatParam("ao_falloff", 1.0, 0.0, 1000.0, "1/m",
                    "AO distance falloff lambda in f(r) = 1 / (1 + lambda r) (Crassin §6)"),
     };
-    info.checkParams = checkVctParams;
     return info;
 }
 
 void VctTechnique::setup(TechniqueContext& ctx) {
     const ParamSet& p = ctx.params;
-    checkVctParams(p);
     const uint32_t n = uint32_t(p.getInt("voxel_resolution"));
     int mapRes = p.getInt("light_map_resolution");
     m_octree = p.getEnum("storage") == "octree";

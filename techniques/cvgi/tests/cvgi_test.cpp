@@ -342,11 +342,10 @@ TEST_F(GpuCvgi, UnsupportedLightsGiveAReason) {
 
 TEST(CpuCvgiParams, EvenGaussianKernelIsRejectedByName) {
     ParamSet p = TechniqueRegistry::instance().defaultParams("cvgi");
-    p.set("gaussian_kernel", "4");
-    EXPECT_THROW(
+    EXPECT_THROW(  // the declaration's rule (0 or odd), checked when the value is set
         {
             try {
-                cvgiSettingsFrom(p);
+                p.set("gaussian_kernel", "4");
             } catch (const Error& e) {
                 EXPECT_NE(std::string(e.what()).find("gaussian_kernel"), std::string::npos);
                 throw;
