@@ -192,6 +192,18 @@ ONE_BOUNCE = Basis("one_bounce", "vs. the one-bounce reference (emission + direc
                    lambda r: _one_bounce(r).rel_mse_sigma, lambda r: "emission+direct+bounce1")
 
 
+def scene_noise_floor(runs: list[Run], basis: Basis) -> Optional[float]:
+    """The scene's HDR-FLIP noise floor on the basis: the median over its measured runs of
+    error_bars.flip.floor_mean (the HDR-FLIP of the reference's noise alone, what an exact
+    image scores); frame 0's on an animated scene. None when no run recorded it."""
+    view = (lambda r: r.final) if basis.name == "matched" else (lambda r: r.vs_full)
+    values = sorted(v for v in (view(r).flip_floor for r in runs if r.measured) if v is not None)
+    if not values:
+        return None
+    mid = len(values) // 2
+    return values[mid] if len(values) % 2 else 0.5 * (values[mid - 1] + values[mid])
+
+
 def has_one_bounce(runs: list[Run]) -> bool:
     """Whether a one-bounce technique ran next to others (then every run is also ranked against
     the one-bounce reference, so `direct` and 1-bounce GI share one yardstick)."""
@@ -404,7 +416,7 @@ def find_sweeps(runs: list[Run]) -> list[Sweep]:
             values = {text(param_value(r, key)) for r in group}
             if len(values) < 2:
                 continue
-            others = [k for k in keys if k != key]
+            others = [k for k in keys if k != key] + _varying_unswept(group, keys)
             numeric = all(sweep_x(r, key) is not None for r in group)
             series: dict[tuple, list[Run]] = {}
             for run in group:
@@ -415,6 +427,19 @@ def find_sweeps(runs: list[Run]) -> list[Sweep]:
             ordered = dict(sorted(series.items(), key=lambda item: _series_order(item[0])))
             sweeps.append(Sweep(tech, scene, key, others, ordered, numeric, keyset))
     return sweeps
+
+
+# Parameters that never split a sweep's lines: seeds and repeats are the spread of one point.
+SPREAD_KEYS = ("seed", "repeat")
+
+
+def _varying_unswept(group: list[Run], swept: tuple[str, ...]) -> list[str]:
+    """Parameters that are not swept but differ between the runs of a sweep (e.g. two config
+    blocks sweeping the same keys at two `lift` values): each of their values is a line of its
+    own, or a line would join runs that differ in more than its key."""
+    names = ordered_unique([k for r in group for k in r.params])
+    return [k for k in names if k not in swept and k not in SPREAD_KEYS
+            and len({text(param_value(r, k)) for r in group}) > 1]
 
 
 def sweep_names(sweeps: list[Sweep]) -> list[str]:

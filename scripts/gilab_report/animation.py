@@ -52,7 +52,8 @@ def _time_cell(summary: Optional[TimeSummary], col: str) -> str:
 
 
 def _run_cells(run: Run, page: Page) -> str:
-    return (f"<td>{swatch(run.technique, page)}</td><td class='params'>{params_html(run)}</td>"
+    params = params_html(run, page.distinguishing(run))
+    return (f"<td>{swatch(run.technique, page)}</td><td class='params'>{params}</td>"
             f"<td>{update_badge(run) or DASH}</td>")
 
 
@@ -185,7 +186,8 @@ def frame_strip(runs: list[Run], page: Page, scene: str) -> str:
         tmap = run.output_path("temporal_png")
         tail = (f'<td class="tmap">{img_html(tmap, page, f"{run.technique} temporal map", STRIP_IMAGE_WIDTH, "tmap", True)}</td>'
                 if tmap else '<td class="tmap"></td>')
-        title = (f"{swatch(run.technique, page)} <span class='pm'>{params_html(run)}</span>"
+        params = params_html(run, page.distinguishing(run))
+        title = (f"{swatch(run.technique, page)} <span class='pm'>{params}</span>"
                  f"<br>{update_badge(run)}")
         rows.append(f'<tr class="strip-run" data-key="{esc(run.key)}"><th>{title}</th>'
                     f"{cells}{pad}{tail}</tr>")

@@ -49,6 +49,14 @@ class Page:
     inspector: Optional[Inspector] = None  # the image inspector's data (inspector)
     study: list = field(default_factory=list)  # report_study.Study per device model (2+
     # techniques measured on a scene; empty otherwise)
+    _varying: Optional[dict[str, list[str]]] = field(default=None, repr=False)
+
+    def distinguishing(self, run: Run) -> list[str]:
+        """The parameter keys whose values differ among the runs of run's technique in this
+        report (varying_keys), computed once."""
+        if self._varying is None:
+            self._varying = varying_keys(self.results.runs)
+        return self._varying.get(run.technique, [])
 
     def basis(self, scene: str) -> Basis:
         return self.bases.get(scene) or MATCHED
@@ -77,6 +85,15 @@ def rel_url(path: str, out_dir: str) -> str:
     """A relative, percent-encoded URL from the page to a file ('#' in scene labels!)."""
     rel = os.path.relpath(path, out_dir).replace(os.sep, "/")
     return urllib.parse.quote(rel, safe="/._-~")
+
+
+def shown_path(path: str, page: Page) -> str:
+    """A path as the page shows it: relative to the report's folder, never the writing
+    machine's absolute path ("." is named: "this folder (study/)")."""
+    rel = os.path.relpath(path, page.out_dir)
+    if rel == ".":
+        return f"this folder ({os.path.basename(os.path.normpath(path))}/)"
+    return rel
 
 
 def png_size(path: str) -> Optional[tuple[int, int]]:
@@ -182,10 +199,30 @@ def status_badge(status: str) -> str:
 SHORT_PARAMS = 3  # parameter lists up to this long are shown whole
 
 
-def params_html(run: Run) -> str:
-    """Swept parameters in bold; the others inline when the list is short, else one click away
-    in a <details> ("+ N more")."""
-    keys = ordered_unique(list(run.swept) + list(run.params))
+def run_keys(run: Run) -> list[str]:
+    """The run's parameter keys: the swept ones first, then the rest of technique.params."""
+    return ordered_unique(list(run.swept) + list(run.params))
+
+
+def varying_keys(runs: list[Run]) -> dict[str, list[str]]:
+    """Per technique: the parameter keys whose values differ among its runs (a key missing
+    from a run counts as a value), in the order of its runs' keys."""
+    keys: dict[str, list[str]] = {}
+    for run in runs:
+        keys[run.technique] = ordered_unique(keys.get(run.technique, []) + run_keys(run))
+    values: dict[str, dict[str, set[str]]] = {t: {k: set() for k in ks}
+                                              for t, ks in keys.items()}
+    for run in runs:
+        for key, seen in values[run.technique].items():
+            seen.add(text(param_value(run, key)))
+    return {tech: [k for k, v in seen.items() if len(v) > 1] for tech, seen in values.items()}
+
+
+def params_html(run: Run, distinguishing: Optional[list[str]] = None) -> str:
+    """Swept parameters in bold, then those that distinguish the run from the other runs of
+    its technique (distinguishing, Page.distinguishing); the others inline when the list is
+    short, else one click away in a <details> ("+ N more")."""
+    keys = run_keys(run)
     if not keys:
         return f'<span class="muted">{DASH}</span>'
 
@@ -193,14 +230,37 @@ def params_html(run: Run) -> str:
         shown = f"{esc(key)}={esc(param_value(run, key))}"
         return f"<b>{shown}</b>" if key in run.swept else shown
 
-    swept = [k for k in keys if k in run.swept]
-    rest = [k for k in keys if k not in run.swept]
     if len(keys) <= SHORT_PARAMS:
         return ", ".join(item(k) for k in keys)
-    head = ", ".join(item(k) for k in swept)
-    more = "more" if swept else "parameters"
-    return (f'{head} <details class="more-params"><summary>+ {len(rest)} {more}</summary>'
+    wanted = set(run.swept) | set(distinguishing or [])
+    head = [k for k in keys if k in run.swept] + [k for k in keys if k in wanted
+                                                  and k not in run.swept]
+    rest = [k for k in keys if k not in wanted]
+    if not rest:
+        return ", ".join(item(k) for k in head)
+    more = "more" if head else "parameters"
+    return (f'<span class="key-params">{", ".join(item(k) for k in head)}</span> '
+            f'<details class="more-params"><summary>+ {len(rest)} {more}</summary>'
             + ", ".join(item(k) for k in rest) + "</details>")
+
+
+def distinct_labels(runs: list[Run], label: Callable[[Run], str]) -> list[str]:
+    """label(run) for each run; where two runs share a label, each gets the parameters that
+    differ among those runs ('cvgi on cornell_spot (gather=paper)'), else its run key."""
+    groups: dict[str, list[Run]] = {}
+    for run in runs:
+        groups.setdefault(label(run), []).append(run)
+    out = []
+    for run in runs:
+        same = [r for r in groups[label(run)] if r is not run]
+        if not same:
+            out.append(label(run))
+            continue
+        keys = [k for k in run_keys(run) if any(text(param_value(r, k)) !=
+                                                text(param_value(run, k)) for r in same)]
+        detail = ", ".join(f"{k}={text(param_value(run, k))}" for k in keys)
+        out.append(f"{label(run)} ({detail or 'run ' + run.key[:12]})")
+    return out
 
 
 def doc_link(page: Page, name: str) -> str:

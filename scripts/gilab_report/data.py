@@ -86,6 +86,7 @@ class MetricView:
     flip_mean: Optional[float] = None
     flip_sigma: Optional[float] = None
     flip_within_noise: bool = False
+    flip_floor: Optional[float] = None  # HDR-FLIP of the reference's noise alone (floor_mean)
     rel_mse: Optional[float] = None
     rel_mse_sigma: Optional[float] = None
     psnr_ldr: Optional[float] = None
@@ -106,6 +107,7 @@ class MetricView:
             flip_mean=num(dig(metric(metric_set, "flip"), "mean")),
             flip_sigma=num(dig(flip_bar, "spread")) if available else None,
             flip_within_noise=available and metric(flip_bar, "within_noise") is True,
+            flip_floor=num(metric(flip_bar, "floor_mean")) if available else None,
             rel_mse=num(metric(metric_set, "rel_mse")),
             rel_mse_sigma=num(metric(bars, "rel_mse_sigma")) if available else None,
             psnr_ldr=num(metric(metric_set, "psnr_ldr")),

@@ -23,7 +23,8 @@ from .analysis import (GREYS, MATCHED, Basis, Sweep, baseline_value,  # noqa: E4
 from .device import (DYNAMIC_FRAME, device_group, device_groups,  # noqa: E402
                            device_label, dynamic_clock, nodes_phrase, time_label)
 from .data import Run, Temporal, text  # noqa: E402
-from .noise import NOISY_IQR_FRACTION, noisy_run, noisy_time  # noqa: E402
+from .noise import (NOISY_COLOR, NOISY_GID, NOISY_IQR_FRACTION, NOISY_LABEL,  # noqa: E402
+                    noisy_run, noisy_time)
 
 STYLE = {
     "svg.fonttype": "none",
@@ -46,9 +47,6 @@ FRONT_STYLES = ("--", ":", "-.", (0, (6, 2, 1, 2, 1, 2)), (0, (1, 1)), (0, (8, 3
 IQR_GID = "iqr-bars"  # SVG id prefix of the frame-time IQR bars (the report's test looks for it)
 SEQUENCE_GID = "seq-line-"  # + run key: one line per run in the per-frame error figure
 TEMPORAL_GID = "temporal-bar-"  # + run key: one bar per run in the temporal-instability figure
-NOISY_GID = "noisy-time-"  # + run key: the marker of a noisy frame time (IQR > 10 % of median)
-NOISY_COLOR = "#b3261e"
-NOISY_LABEL = f"noisy frame time: IQR > {100 * NOISY_IQR_FRACTION:.0f} % of the median"
 LOG_SPAN = 10.0  # use a log axis when the largest positive value is > LOG_SPAN x the smallest
 
 Metric = Callable[[Run], Optional[float]]

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import datetime
 import glob
+import json
 import os
 import platform
 import sys
@@ -51,6 +52,117 @@ def check_dirs(dirs: list[str]) -> list[str]:
     """Messages for every DIR that is not a folder."""
     return [f"make_report: results folder '{d}' does not exist" if not os.path.exists(d)
             else f"make_report: '{d}' is not a folder" for d in dirs if not os.path.isdir(d)]
+
+
+def is_results_folder(path: str) -> bool:
+    """A folder the runner writes: runs/<key>/result.json (runs/ may still be empty)."""
+    return os.path.isdir(os.path.join(path, "runs"))
+
+
+def results_folders_below(path: str, depth: int = 3) -> list[str]:
+    """Folders under path (at most depth levels down) that look like results folders: a runs/
+    subfolder or a results.jsonl."""
+    found = []
+    for root, subdirs, files in os.walk(path):
+        level = os.path.relpath(root, path).count(os.sep) + (root != path)
+        if root != path and ("runs" in subdirs or "results.jsonl" in files):
+            found.append(root)
+            subdirs[:] = []  # a results folder's own subfolders are not listed
+            continue
+        subdirs[:] = sorted(d for d in subdirs if not d.startswith(".")) if level < depth else []
+    return found
+
+
+def not_results_folders(dirs: list[str]) -> list[str]:
+    """Messages for every DIR without a runs/ folder: no runs found in it, and the results
+    folders below it (e.g. DIR is results/, the parent of results/<experiment>/)."""
+    out = []
+    for d in dirs:
+        if is_results_folder(d):
+            continue
+        below = results_folders_below(d)
+        lines = [f"make_report: found no runs in '{d}' (no runs/ folder: it is not a results "
+                 "folder)"]
+        if os.path.isfile(os.path.join(d, "results.jsonl")):
+            lines.append("  it has a results.jsonl, but the report reads runs/<key>/result.json")
+        if below:
+            lines.append("  results folders below it (pass one or more of them):")
+            lines += [f"    {_shown(b)}" for b in below[:20]]
+            if len(below) > 20:
+                lines.append(f"    … and {len(below) - 20} more")
+        out.append("\n".join(lines))
+    return out
+
+
+SKIPPED_SHOWN = 10  # skipped files listed one per line; the rest are counted
+
+
+def _shown(path: str) -> str:
+    """A path for the terminal: relative to the working folder when under it."""
+    rel = os.path.relpath(path)
+    return path if rel.startswith("..") else rel
+
+
+def _listed(header: str, items: list[str]) -> list[str]:
+    more = len(items) - SKIPPED_SHOWN
+    return ([header] + [f"  {i}" for i in items[:SKIPPED_SHOWN]]
+            + ([f"  … and {more} more (all listed in the report)"] if more > 0 else []))
+
+
+def missing_outputs(run: Run) -> list[str]:
+    """The files a run's result.json lists under outputs that are not on disk."""
+    outputs = run.data.get("outputs")
+    missing = []
+    for name, value in (outputs.items() if isinstance(outputs, dict) else []):
+        if isinstance(value, str) and value:
+            path = run.output_path(name)
+            if path and not os.path.isfile(path):
+                missing.append(name)
+    return missing
+
+
+def broken_jsonl_lines(results_dir: str) -> list[int]:
+    """Line numbers of results.jsonl that are not a JSON object (the report does not read the
+    file, but a broken line says the folder was damaged)."""
+    path = os.path.join(results_dir, "results.jsonl")
+    bad = []
+    try:
+        with open(path, encoding="utf-8", errors="replace") as f:
+            for number, line in enumerate(f, 1):
+                try:
+                    ok = isinstance(json.loads(line), dict) if line.strip() else True
+                except ValueError:
+                    ok = False
+                if not ok:
+                    bad.append(number)
+    except OSError:
+        pass
+    return bad
+
+
+def skipped_lines(results: Results) -> list[str]:
+    """What the terminal is told about unreadable or incomplete input (empty when none)."""
+    out = []
+    if results.unreadable:
+        out += _listed(f"make_report: skipped {len(results.unreadable)} unreadable run "
+                       "folder(s):", [f"{_shown(u.path)}: {u.why}"
+                                      for u in results.unreadable])
+    lacking = [(r, m) for r in results.runs for m in [missing_outputs(r)] if m]
+    if lacking:
+        out += _listed(f"make_report: {len(lacking)} run(s) lack files their result.json lists "
+                       "(shown as missing on the page):",
+                       [f"{_shown(r.folder)}: {', '.join(m)}" for r, m in lacking])
+    for d in results.dirs:
+        bad = broken_jsonl_lines(d)
+        if bad:
+            out.append(f"make_report: {_shown(os.path.join(d, 'results.jsonl'))}: "
+                       f"{len(bad)} line(s) are not JSON objects (line "
+                       f"{', '.join(map(str, bad[:5]))}{', …' if len(bad) > 5 else ''}); the "
+                       "report does not read results.jsonl (it reads runs/*/result.json)")
+    if not results.runs and not results.unreadable:
+        out.append("make_report: no finished runs yet in "
+                   f"{', '.join(map(_shown, results.dirs))}; the page says so")
+    return out
 
 
 def clear_old_figures(fig_dir: str) -> None:
@@ -189,9 +301,10 @@ def tool_versions() -> str:
     return f"Python {platform.python_version()}, matplotlib {matplotlib.__version__}"
 
 
-def build_report(dirs: list[str], out_dir: str) -> str:
-    """Writes out_dir/report.html (and figures) from the runs in dirs; returns its path."""
-    results = load_results(dirs)
+def build_report(dirs: list[str], out_dir: str, results: Optional[Results] = None) -> str:
+    """Writes out_dir/report.html (and figures) from the runs in dirs (already loaded:
+    results); returns its path."""
+    results = results if results is not None else load_results(dirs)
     out_dir = os.path.abspath(out_dir)
     os.makedirs(out_dir, exist_ok=True)
     colors = technique_colors([r.technique for r in results.runs])
@@ -220,10 +333,18 @@ def build_report(dirs: list[str], out_dir: str) -> str:
 
 def main(argv: list[str]) -> int:
     args = parse_args(argv)
-    problems = check_dirs(args.dirs)
+    problems = check_dirs(args.dirs) or not_results_folders(args.dirs)
     if problems:
         print("\n".join(problems), file=sys.stderr)
         return 2
-    path = build_report(args.dirs, args.out or args.dirs[0])
+    results = load_results(args.dirs)
+    skipped = skipped_lines(results)
+    if skipped:
+        print("\n".join(skipped), file=sys.stderr)
+    if results.unreadable and not results.runs:
+        print(f"make_report: no readable run in {', '.join(args.dirs)}; no report written",
+              file=sys.stderr)
+        return 2
+    path = build_report(args.dirs, args.out or args.dirs[0], results)
     print(path)
     return 0

@@ -19,6 +19,10 @@ Metric = Callable[[Run], Optional[float]]
 # A timing whose interquartile range is above this fraction of its median is flagged as noisy
 # wherever it is shown (docs/report.md, "Noisy timings").
 NOISY_IQR_FRACTION = 0.10
+# How figures mark a noisy frame time: a red square, SVG id NOISY_GID + run key, a legend entry.
+NOISY_GID = "noisy-time-"
+NOISY_COLOR = "#b3261e"
+NOISY_LABEL = f"noisy frame time: IQR > {100 * NOISY_IQR_FRACTION:.0f} % of the median"
 
 
 def noisy_time(median: Optional[float], iqr: Optional[float]) -> bool:
@@ -98,21 +102,42 @@ def tied_best(best: Run, runs: list[Run], error: Metric, sigma: Metric) -> list[
 
 
 def change_words(first: float, first_sigma: Optional[float], last: float,
-                 last_sigma: Optional[float], fmt: Callable[[float], str]) -> str:
-    """'falls from a to b' / 'rises from a to b' when separable, else 'no change beyond the
-    noise (a … b)'."""
-    if clearly_lower(last, last_sigma, first, first_sigma):
-        return f"falls from {fmt(first)} to {fmt(last)}"
-    if clearly_lower(first, first_sigma, last, last_sigma):
-        return f"rises from {fmt(first)} to {fmt(last)}"
-    return f"no change beyond the noise ({fmt(first)} … {fmt(last)})"
+                 last_sigma: Optional[float], fmt: Callable[[float], str],
+                 floor: Optional[float] = None, seed_sigma: float = 0.0) -> str:
+    """'falls from a to b' / 'rises from a to b' only when |b − a| is beyond the noise band,
+    else 'unchanged within noise (±band: …)'. The band is the larger of the scene's noise
+    floor (floor: the HDR-FLIP of the reference's noise alone; a smaller change of the mean is
+    less than the reference's own noise shows) and the 1σ of the difference (error bars and the
+    technique's seed spread, verdicts.error_bound)."""
+    bars = V.error_bound(V.Entry("", "", None, first, error_sigma=abs(first_sigma or 0.0),
+                                 seed_sigma=seed_sigma),
+                         V.Entry("", "", None, last, error_sigma=abs(last_sigma or 0.0),
+                                 seed_sigma=seed_sigma))
+    band = max(floor or 0.0, bars)
+    source = ("the reference's noise floor" if floor and floor >= bars else
+              "the error bars" + (" and seed spread" if seed_sigma else ""))
+    if abs(last - first) > band:
+        verb = "falls" if last < first else "rises"
+        beyond = f" (beyond ±{fmt(band)}, {source})" if band > 0 else ""
+        return f"{verb} from {fmt(first)} to {fmt(last)}{beyond}"
+    if band == 0:
+        return f"unchanged ({fmt(first)} … {fmt(last)})"
+    return (f"unchanged within noise (±{fmt(band)}, {source}: {fmt(first)} … {fmt(last)})")
 
 
-def time_change_words(first: Run, last: Run, fmt: Callable[[float], str]) -> str:
-    """The frame-time change between two runs, in words, only when their IQRs separate."""
+def time_change_words(first: Run, last: Run, fmt: Callable[[float], str],
+                      spread: Optional[float] = None) -> str:
+    """The frame-time change between two runs, in words, only beyond their IQRs (and the
+    technique's between-run spread, a fraction of the time, where measured: spread)."""
     if first.frame_ms is None or last.frame_ms is None:
         return "unknown"
-    if time_separable(first, last):
+    a, b = _time_entry(first), _time_entry(last)
+    if spread:
+        a.time_spread, b.time_spread = max(a.time_spread, spread), max(b.time_spread, spread)
+    band = V.time_bound(a, b)
+    if abs(last.frame_ms - first.frame_ms) > band:
         verb = "falls" if last.frame_ms < first.frame_ms else "rises"
         return f"{verb} from {fmt(first.frame_ms)} to {fmt(last.frame_ms)} ms"
-    return f"no change beyond the IQR ({fmt(first.frame_ms)} … {fmt(last.frame_ms)} ms)"
+    what = "IQR and run-to-run spread" if spread else "IQR"
+    return (f"unchanged within noise (±{fmt(band)} ms, {what}: {fmt(first.frame_ms)} … "
+            f"{fmt(last.frame_ms)} ms)")

@@ -11,16 +11,17 @@ from dataclasses import dataclass
 from typing import Optional
 
 from .analysis import (Sweep, best_key, best_runs, by_device, by_scene, param_value,
-                             params_text, pareto_fronts, pareto_ties, slug)
+                             params_text, pareto_fronts, pareto_ties, scene_noise_floor, slug)
 from .assets import BODY_JS, CSS, HEAD_JS, INSPECTOR_JS, MAGMA_STOPS
 from .animation import animation_anchor, animation_html
 from .common import (CARD_IMAGE_WIDTH, DASH, REF_IMAGE_WIDTH, Page, doc_link,
                            esc, fmt_fixed, fmt_flip, fmt_ms, fmt_sig, img_html, noisy_mark,
-                           nonfinite_count, params_html, rel_url, scene_anchor, status_badge,
-                           swatch, time_with_bar, update_badge, with_bar)
+                           nonfinite_count, params_html, rel_url, scene_anchor, shown_path,
+                           status_badge, swatch, time_with_bar, update_badge, with_bar)
 from .data import Run, dig, num, text
 from .device import (DYNAMIC_FRAME, device_groups, device_label, device_names,
                            dynamic_clock, hosts_of, nodes_phrase, time_label)
+from .guide import flip_guide_html
 from .inspector import BUDGET_CHARS, MAX_PIXELS, Layer
 from .noise import (NOISY_IQR_FRACTION, change_words, noisy_run, noisy_time, tied_best,
                           time_change_words)
@@ -221,7 +222,7 @@ def _card(run: Run, page: Page, rank: Optional[int], badge: str, lazy: bool,
     return (f'<div class="card" style="border-top-color:{color}" data-key="{esc(run.key)}"'
             f'{rank_attr}>'
             f'<div class="card-title">{swatch(run.technique, page)}{badges}</div>'
-            f'<div class="card-params">{params_html(run)}</div>'
+            f'<div class="card-params">{params_html(run, page.distinguishing(run))}</div>'
             f'<div class="pair">{pair}</div>{note}'
             f'<div class="card-nums">{_card_numbers(run, page, ties)}</div>'
             f'<div class="card-links">{_exr_link(run, page)}</div></div>')
@@ -349,10 +350,11 @@ def _best_badge(best: Run, rivals: list[Run], page: Page, group: str) -> str:
     where = f" vs {group}" if group else ""
     if not ties:
         return (f'<span class="badge b-best" title="lowest {esc(basis.label("HDR-FLIP", group))}'
-                f' of every technique">best{esc(where)}</span>')
+                f' of every technique, at any frame time">lowest error{esc(where)}</span>')
     names = ", ".join(sorted({r.technique for r in ties}))
     return (f'<span class="badge b-best b-tie" title="lowest {esc(basis.label("HDR-FLIP", group))}'
-            f', but {esc(names)} within the error bars">best{esc(where)} (tie)</span>')
+            f', at any frame time, but {esc(names)} within the error bars">lowest error'
+            f'{esc(where)} (tie)</span>')
 
 
 def scene_section(scene: str, runs: list[Run], page: Page) -> str:
@@ -405,8 +407,10 @@ def scene_section(scene: str, runs: list[Run], page: Page) -> str:
                      'are frame 0, every frame is in the <a href="#'
                      f'{animation_anchor(scene)}">animation section</a>'
                      if dynamic_clock(measured) else "")
-                  + ". Cards in rank order (#1 first), each technique's best run; the badge "
-                  "marks the best of all.</p>")
+                  + ". Cards in rank order (#1 first), each technique's lowest-error run; the "
+                  "badge marks the lowest error of all, at any frame time"
+                  + (" (the verdict at the top weighs frame time too)" if page.study else "")
+                  + ".</p>")
     return (f'<section class="scene" id="{scene_anchor(scene)}">{title}{basis_line}'
             f'{_direct_accuracy_line(measured, page)}'
             f'{_exposure_bar()}<div class="cards">{"".join(cards)}</div>{"".join(details)}'
@@ -422,15 +426,47 @@ def _inspector_words(page: Page) -> str:
     skipped = (f" {ins.skipped_budget} more were left out: the page's budget of "
                f"{BUDGET_CHARS // (1024 * 1024)} MiB for them is spent."
                if ins and ins.skipped_budget else "")
-    return (f'<b>Click any image</b> to inspect it: nearest-neighbour zoom (+/−, 0 = fit), flip '
+    return (f'<b>Click any image</b> to inspect it: nearest-neighbour zoom at the cursor (wheel '
+            'or +/−, 0 = fit, drag to pan), flip '
             'between the run, the reference and the error maps of its card (keys 1–9, ← → or '
-            'space) and read the <b>linear values</b> under the cursor. The values come from '
+            'space) and read the <b>linear values</b> under the cursor (on an error map, the '
+            'error, with a colour bar). The values come from '
             'the runs\' and references\' EXR files, embedded in this page as float16 RGB '
             f'(base64) for images of at most {side}×{side} pixels: {count} images, '
-            f'{size:,.0f} KiB.{skipped} The error map against the full reference is the '
-            'runner\'s HDR-FLIP map (<code>outputs.flip_full_png</code>) where it wrote one; '
-            f'else the report draws its own: {esc(RELERR_WORDS)}. A link '
+            f'{size:,.0f} KiB.{skipped} {_full_map_words(page)} A link '
             '<code>report.html#inspect=&lt;run key&gt;</code> opens the inspector on a run.')
+
+
+def _full_map_runs(page: Page) -> tuple[list[Run], list[Run]]:
+    """The measured runs of full-basis scenes with and without the runner's HDR-FLIP map
+    against the full reference on disk (outputs.flip_full_png)."""
+    runs = [r for r in page.results.runs if r.measured and page.basis(r.scene).name != "matched"
+            and _exists(r.reference_path("full_png"))]
+    with_map = [r for r in runs if _exists(r.output_path("flip_full_png"))]
+    return with_map, [r for r in runs if not _exists(r.output_path("flip_full_png"))]
+
+
+def _full_map_words(page: Page) -> str:
+    """What the error maps against the full reference are on this page: the runner's HDR-FLIP
+    maps, and the report's own relative-error map only for the runs without one."""
+    with_map, without = _full_map_runs(page)
+    if not with_map and not without:
+        return ""
+    flip = ('the runner\'s HDR-FLIP map (<code>outputs.flip_full_png</code>; magma, 0 = no '
+            'visible difference, 1 = maximal)')
+    if not without:
+        return (f'The error map against the full reference is, on every card '
+                f'(<span class="flip-maps">{len(with_map)}</span> runs), {flip}.')
+    own = f'the report draws its own: {esc(RELERR_WORDS)}'
+    if not with_map:
+        return f'No run has an HDR-FLIP map against the full reference, so {own}.'
+    scenes: dict[str, int] = {}
+    for run in without:
+        scenes[run.scene] = scenes.get(run.scene, 0) + 1
+    where = ", ".join(f"{n} on {esc(scene)}" for scene, n in scenes.items())
+    return (f'The error map against the full reference is {flip} for '
+            f'<span class="flip-maps">{len(with_map)}</span> runs; for the '
+            f'<span class="own-maps">{len(without)}</span> runs without one ({where}) {own}.')
 
 
 def scenes_html(page: Page) -> str:
@@ -446,8 +482,8 @@ def scenes_html(page: Page) -> str:
             'indirect layer next to the reference\'s matching indirect layer, and a link to its '
             'linear EXR. The first number of a card is the ranking basis; the bounce-matched '
             'error and the direct-light error (shared by every technique) follow, each '
-            'labelled. "best (tie)": another technique\'s best run is within the error '
-            f'bars.</p><p class="inspector-note">{_inspector_words(page)}</p>' + body)
+            'labelled. "lowest error (tie)": another technique\'s best run is within the '
+            f'error bars.</p><p class="inspector-note">{_inspector_words(page)}</p>' + body)
 
 
 
@@ -475,7 +511,8 @@ def _front_table(front: list[Run], page: Page, scene: str, group: str, ties: dic
         mark = ("front" if tie is None else f"tie with {esc(params_text(tie, True)) or tie.technique}"
                 f" ({esc(tie.technique)})")
         rows.append(f'<tr data-key="{esc(run.key)}"><td>{swatch(run.technique, page)}</td>'
-                    f"<td class='params'>{params_html(run)}</td><td class='n c-time'>"
+                    f"<td class='params'>{params_html(run, page.distinguishing(run))}</td>"
+                    "<td class='n c-time'>"
                     f"{time_with_bar(run.frame_ms, run.frame_iqr)}</td>"
                     f'<td class="n" data-key="{esc(run.key)}" data-basis="{esc(basis.name)}" '
                     f'data-v="{basis.flip(run)!r}">'
@@ -614,10 +651,22 @@ def _series_name(sweep: Sweep, others: tuple) -> str:
     return ", ".join(f"{k}={v}" for k, v in zip(sweep.other_keys, others)) or "all runs"
 
 
+def study_spreads(page: Page, technique: str) -> tuple[float, Optional[float]]:
+    """The technique's seed spread of HDR-FLIP (0 when not run) and relative between-run
+    spread of the frame time (None when not measured) from the cross-technique study."""
+    for study in page.study:
+        if technique in study.seed_spread or technique in study.time_spread:
+            return study.seed_spread.get(technique, 0.0), study.time_spread.get(technique)
+    return 0.0, None
+
+
 def sweep_summary(sweep: Sweep, page: Page) -> str:
     """Per series: how the headline error and the frame time change from the smallest to the
-    largest value of the swept key, called a change only beyond the error bars / IQR."""
+    largest value of the swept key, called a change only beyond the noise: the scene's noise
+    floor, the error bars and seed spread (error), the IQRs and run-to-run spread (time)."""
     basis = page.basis(sweep.scene)
+    floor = scene_noise_floor(by_scene(page.results.runs).get(sweep.scene, []), basis)
+    seeds, spread = study_spreads(page, sweep.technique)
     items = []
     for others, members in sweep.series.items():
         ok = [r for r in members if r.status == "ok" and basis.flip(r) is not None]
@@ -625,12 +674,12 @@ def sweep_summary(sweep: Sweep, page: Page) -> str:
             continue
         first, last = ok[0], ok[-1]
         error = change_words(basis.flip(first), basis.flip_sigma(first), basis.flip(last),
-                             basis.flip_sigma(last), fmt_flip)
+                             basis.flip_sigma(last), fmt_flip, floor, seeds)
         items.append(f"<li>{esc(_series_name(sweep, others))}: from {esc(sweep.key)}="
                      f"{esc(text(param_value(first, sweep.key)))} to "
                      f"{esc(text(param_value(last, sweep.key)))}, "
                      f"{esc(basis.label('HDR-FLIP'))} {esc(error)}; frame time "
-                     f"{esc(time_change_words(first, last, fmt_ms))}"
+                     f"{esc(time_change_words(first, last, fmt_ms, spread))}"
                      + "".join(f" ({esc(sweep.key)}={esc(text(param_value(r, sweep.key)))}:"
                                f"{noisy_mark(r.frame_ms, r.frame_iqr)})" for r in (first, last)
                                if noisy_run(r))
@@ -655,8 +704,12 @@ def sweeps_html(page: Page) -> str:
              'reference), the bounce-matched error, relMSE and the frame time (bars: its IQR) '
              'against that parameter. For grids, one line per value of the other swept '
              'parameter(s), light to dark. ✕ marks a run with non-finite output. A change is '
-             'only called a rise or a fall when the error bars (error) or the IQRs (time) of '
-             'the two ends do not overlap. A parameter whose runs give identical images is '
+             'only called a rise or a fall when it is larger than the noise: for the error, the '
+             'scene\'s noise floor (the HDR-FLIP of the reference\'s own noise, see the '
+             '<a href="#flip-guide">guide to HDR-FLIP</a>) or the two ends\' error bars and '
+             'seed spread, whichever is larger; for the time, their IQRs and the technique\'s '
+             'run-to-run spread. Anything smaller is "unchanged within noise (±band)". A '
+             'parameter whose runs give identical images is '
              'reported as having no effect on the scene.</p>']
     all_sweeps = [s for s, _ in page.figures.sweeps] + [s for s, _ in page.figures.no_effect]
     for sweep, path in page.figures.sweeps:
@@ -731,10 +784,11 @@ def inspector_html(page: Page) -> str:
             '<div class="ins-status"><span class="ins-pos">move the cursor over the image'
             '</span> <span class="ins-value"></span><div class="ins-more"></div></div>'
             '<div class="ins-help">keys: 1–9 a layer · ← → or space: previous / next layer · '
-            '+ / −: zoom (nearest neighbour) · 0: fit · Esc: close. Values: linear RGB from the '
-            'EXR files (float16, so about 3 significant digits); error maps are colours (the '
-            'FLIP value is not stored), except the report\'s own map, whose value is computed '
-            'from the linear images.</div></div>'
+            'wheel or + / − over the image: zoom at the cursor (nearest neighbour) · drag: pan · '
+            '0: fit · Esc: close. Values: linear RGB from the EXR files (float16, so about 3 '
+            'significant digits); on an error map, its value (HDR-FLIP maps to ±0.002, read back '
+            'from the map\'s colours; the report\'s own map computed from the linear images), '
+            'with the colour bar above the image.</div></div>'
             f'<script type="application/json" id="gilab-inspector">{payload}</script>'
             '<pre id="inspector-selftest-result" hidden></pre>')
 
@@ -772,18 +826,21 @@ def verdict_html(page: Page) -> str:
 
 
 def render_page(page: Page) -> str:
-    sections = [invalid_banner_html(page), study_html(page), equal_html(page), scenes_html(page),
+    study = study_html(page)
+    sections = [invalid_banner_html(page), study, equal_html(page, folded=bool(study)),
+                scenes_html(page),
                 animation_html(page), run_table_html(page) + failures_html(page),
                 pareto_html(page), sweeps_html(page), passes_html(page), skipped_html(page),
                 unreadable_html(page)]
     body = "".join(sections)
     if not page.results.runs:
         body = ('<div class="empty" id="empty">No finished runs in '
-                + ", ".join(f"<code>{esc(d)}</code>" for d in page.results.dirs)
+                + ", ".join(f"<code>{esc(shown_path(d, page))}</code>"
+                            for d in page.results.dirs)
                 + ". Run the experiment first (<code>gilab run CONFIG</code>); runs in progress "
                 "(folders starting with '.') are not shown.</div>") + unreadable_html(page)
     nav = [(i, t) for i, t in NAV_TITLES if f'id="{i}"' in body or i == "definitions"]
-    header = header_html(page, verdict_html(page))
+    header = header_html(page, verdict_html(page) + flip_guide_html(page))
     return render("page.html.j2", title=f"gilab report — {experiment_name(page.results)}",
                   css=Markup(CSS), head_js=Markup(HEAD_JS), header=Markup(header), nav=nav,
                   body=Markup(body), footer=Markup(footer_html(page)),

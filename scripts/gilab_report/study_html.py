@@ -20,6 +20,8 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: 
 from . import cost as C  # noqa: E402
 from . import study as S  # noqa: E402
 from .analysis import shade, technique_colors  # noqa: E402
+from .noise import (NOISY_COLOR, NOISY_GID, NOISY_IQR_FRACTION, NOISY_LABEL,  # noqa: E402
+                    noisy_time)
 from .templates import Markup, render  # noqa: E402
 
 FRONT_COLOR = "#111111"
@@ -88,6 +90,13 @@ def study_figure(st: "S.SceneStudy", colors: dict[str, str], path: str, time_lab
             ring, = ax1.plot([p.x], [p.y], "o", ms=10, mfc="none", mec=FRONT_COLOR, mew=1.0,
                              zorder=5)
             ring.set_gid(f"{STUDY_GID}{p.key}")
+    noisy = [p for p in st.points if p.ranked and noisy_time(p.x, p.x_iqr)]
+    for p in noisy:  # a red square, as in the report's other error-against-time figures
+        mark, = ax1.plot([p.x], [p.y], "s", ms=13, mfc="none", mec=NOISY_COLOR, mew=1.1,
+                         ls="none", zorder=6)
+        mark.set_gid(f"{NOISY_GID}{p.key}")
+    if noisy:
+        ax1.plot([], [], "s", ms=11, mfc="none", mec=NOISY_COLOR, ls="none", label=NOISY_LABEL)
     if st.direct_floor is not None:
         ax1.axhline(st.direct_floor.y, color="#777777", lw=0.8, ls=":", zorder=1)
     for ax in (ax1, ax2):
@@ -236,12 +245,25 @@ def _floor_values(st: "S.SceneStudy") -> dict[str, str]:
                            else "not recorded")}
 
 
+NOISY_TIP = (f"noisy timing: the frame time's interquartile range is more than "
+             f"{100 * NOISY_IQR_FRACTION:.0f} % of its median (see noisy timings)")
+
+
+def noisy_mark(p: "S.Point") -> Markup:
+    """'⚠ 35 %' after a point's time when its IQR is above NOISY_IQR_FRACTION of it."""
+    if not noisy_time(p.x, p.x_iqr):
+        return Markup("")
+    share = 100.0 * p.x_iqr / p.x
+    return Markup(' <span class="noisy" data-noisy="{:.1f}" title="{}">\u26a0 {:.0f} %'
+                  "</span>").format(share, NOISY_TIP, share)
+
+
 def _time_value(p: "S.Point") -> Markup:
-    return Markup("{} <small>({})</small>").format(S.sig3(p.y), S.ms(p.x))
+    return Markup("{} <small>({}{})</small>").format(S.sig3(p.y), S.ms(p.x), noisy_mark(p))
 
 
 def _error_value(p: "S.Point") -> Markup:
-    return Markup("{} <small>({})</small>").format(S.ms(p.x), S.sig3(p.y))
+    return Markup("{}{} <small>({})</small>").format(S.ms(p.x), noisy_mark(p), S.sig3(p.y))
 
 
 def study_section_html(study: "S.Study", colors: dict[str, str],
@@ -264,6 +286,8 @@ def study_section_html(study: "S.Study", colors: dict[str, str],
         scenes.append({
             "name": scene, "leak_test": scene in S.NOT_QUALITY, "floor": _floor_values(st),
             "figure": figure_url(figures[scene]) if scene in figures else None,
+            "noisy": sum(1 for p in st.points if p.ranked and noisy_time(p.x, p.x_iqr)),
+            "noisy_percent": f"{100 * NOISY_IQR_FRACTION:.0f}",
             "equal_time": _table_data(st.equal_time, series, colors, caption, "series",
                                       _time_value),
             "equal_error": _table_data(st.equal_error, series, colors, caption, "series",

@@ -11,10 +11,10 @@ from typing import Callable, Optional
 from .analysis import (MIN_COMPARED, best_within_budget, by_device, by_scene,
                              by_technique, cheapest_reaching, comparable_groups, error_targets,
                              ordered_unique, params_text, slug, time_budgets)
-from .common import (DASH, MIB, Page, doc_link, esc, first_message_html,
+from .common import (DASH, MIB, Page, distinct_labels, doc_link, esc, first_message_html,
                            fmt_fixed, fmt_flip, fmt_ms, fmt_sig, noisy_mark, nonfinite_count,
-                           params_html, rel_url, status_badge, swatch, time_with_bar,
-                           update_badge, validation_summary, with_bar)
+                           params_html, rel_url, shown_path, status_badge, swatch,
+                           time_with_bar, update_badge, validation_summary, with_bar)
 from .data import Results, Run, dig, num, text
 from .device import (device_group, device_groups, device_names, device_note_html,
                            time_label)
@@ -87,7 +87,7 @@ def header_html(page: Page, verdict: str = "") -> str:
     noisy = noisy_summary(page)
     if noisy:
         rows.append(("noisy timings", noisy))
-    rows.append(("results", "<br>".join(esc(d) for d in res.dirs)))
+    rows.append(("results", "<br>".join(esc(shown_path(d, page)) for d in res.dirs)))
     rows.append(("runs", counts_html(page)))
     return render("header.html.j2", name=experiment_name(res), descriptions=descriptions,
                   verdict=Markup(verdict), rows=[(k, Markup(v)) for k, v in rows])
@@ -116,13 +116,17 @@ def noisy_summary(page: Page) -> str:
     if not noisy:
         return ""
     timed = sum(1 for r in runs if r.measured and r.static.median is not None)
-    items = ", ".join(f"{esc(r.technique)} on {esc(r.scene)} ({what} {fmt_ms(m)} ± {fmt_ms(i)} "
-                      f"ms, IQR {100 * i / m:.0f} %)" for r, what, m, i in noisy[:8])
+    labels = distinct_labels([r for r, *_ in noisy], lambda r: f"{r.technique} on {r.scene}")
+    items = ", ".join(f"{esc(label)} ({what} {fmt_ms(m)} ± {fmt_ms(i)} ms, IQR "
+                      f"{100 * i / m:.0f} %)"
+                      for label, (r, what, m, i) in zip(labels[:8], noisy[:8]))
     more = f" and {len(noisy) - 8} more" if len(noisy) > 8 else ""
     return (f'<span class="noisy">\u26a0 {len(noisy)} noisy timing'
             f'{"s" if len(noisy) != 1 else ""}</span> of {timed} timed runs: {items}{more}. '
             f"Their IQR is above {100 * NOISY_IQR_FRACTION:.0f} % of the median; each is marked "
-            '\u26a0 in every table and figure (<a href="#noisy-timings">why</a>).')
+            "\u26a0 in every table and figure that shows the run's own time (the study's too), "
+            "not in summaries over several runs (verdict, ladder reach, whole cost) "
+            '(<a href="#noisy-timings">why</a>).')
 
 
 def _instrumentation(page: Page) -> str:
@@ -346,8 +350,10 @@ def run_columns(page: Page) -> list[Column]:
                lambda r: (swatch(r.technique, page), r.technique), False, "tech"),
         Column("index", "#", "run index in the experiment", lambda r: _n(r.index, text(r.index))),
         Column("scene", "scene", "scene label", lambda r: (esc(r.scene), r.scene), False, ""),
-        Column("params", "parameters", "technique parameters: the swept ones, the others one "
-               "click away", lambda r: (params_html(r), params_text(r)), False, "params"),
+        Column("params", "parameters", "technique parameters: the swept ones and those that "
+               "differ between runs of the technique, the others one click away",
+               lambda r: (params_html(r, page.distinguishing(r)), params_text(r)), False,
+               "params"),
         Column("status", "status", "ok / nonfinite / unsupported (with the reason) / invalid "
                "(Vulkan validation reported errors or warnings: numbers not trusted, not ranked)",
                _status_cell, False, "reason"),
@@ -601,7 +607,32 @@ def _left_out_note(runs: list[Run], groups: dict[str, list[Run]], page: Page) ->
             + ", ".join(swatch(t, page) for t in left_out) + "</p>")
 
 
-def equal_html(page: Page) -> str:
+EQUAL_WORDS = ('Budgets are '
+               'the 1-2-5 series of milliseconds covering the observed median frame times; target '
+               'errors are the 90/75/50/25/10 % quantiles of the observed values (2 significant '
+               'digits). Each cell is the technique\'s best ok run under that constraint (hover '
+               'for its parameters); the best cell of each column is highlighted, and cells that '
+               'cannot be told apart from it (error bars or frame-time IQRs overlap) are marked '
+               f'"(tie)"; {DASH} = no run qualifies; \u26a0 marks a noisy frame time (IQR above '
+               f'{100 * NOISY_IQR_FRACTION:.0f} % of the median). Each table names the device its '
+               'times were measured on.')
+
+# How the per-technique tables differ from the study's verdict (when both are on the page).
+SECOND_VIEW_WORDS = ('<b>The answer to cite is the study\'s verdict</b> (the first screen) and its '
+                     'equal-time and equal-error tables above. These per-technique tables are a '
+                     'second, coarser view of the same runs, and their winners can differ: one '
+                     'row per <i>technique</i> (its best run of any setting, where the study has '
+                     'one row per <i>series</i>, e.g. cvgi with each gather apart); budgets from '
+                     'the observed times (1-2-5 ms series) instead of the study\'s fixed ones; '
+                     'targets from quantiles of the observed errors instead of fractions of the '
+                     'direct floor; ties from IQRs and error bars only (no seed or run-to-run '
+                     'spread), and no compensating or path-tracer rules.')
+
+
+def equal_html(page: Page, folded: bool = False) -> str:
+    """The per-technique equal-time and equal-error tables: the page's answer when there is no
+    study; folded (a closed <details> under a heading that says what they are) when the
+    study's verdict is on the page."""
     parts = []
     for scene, scene_runs in by_scene(page.results.runs).items():
         basis = page.basis(scene)
@@ -618,20 +649,17 @@ def equal_html(page: Page) -> str:
             parts += [f"<h3>{esc(scene)}</h3>"] + tables
     if not parts:
         return ""
+    if folded:
+        return ('<h2 id="equal">Per-technique equal-time and equal-error tables (a second view)'
+                f'</h2><p class="second-view">{SECOND_VIEW_WORDS} {EQUAL_WORDS}</p>'
+                '<details class="second-view"><summary>show the per-technique tables</summary>'
+                + "".join(parts) + "</details>")
     return ('<h2 id="equal">Which technique is best? Equal-time and equal-error comparison'
             '</h2><p>The cross-technique answer, per scene: every run '
             'is compared on the scene\'s one ranking basis, named in each heading: mean HDR-FLIP '
             'against the <b>full reference</b> (all light paths) where measured; results without '
-            'it are compared only with runs of the same bounce-matched reference. Budgets are '
-            'the 1-2-5 series of milliseconds covering the observed median frame times; target '
-            'errors are the 90/75/50/25/10 % quantiles of the observed values (2 significant '
-            'digits). Each cell is the technique\'s best ok run under that constraint (hover '
-            'for its parameters); the best cell of each column is highlighted, and cells that '
-            'cannot be told apart from it (error bars or frame-time IQRs overlap) are marked '
-            f'"(tie)"; {DASH} = no run qualifies; \u26a0 marks a noisy frame time (IQR above '
-            f'{100 * NOISY_IQR_FRACTION:.0f} % of the median). Each table names the device its '
-            'times were measured on. The images, every run and the figures follow.</p>'
-            + "".join(parts))
+            'it are compared only with runs of the same bounce-matched reference. '
+            f'{EQUAL_WORDS} The images, every run and the figures follow.</p>' + "".join(parts))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -678,7 +706,8 @@ def unreadable_html(page: Page) -> str:
     bad = page.results.unreadable
     if not bad:
         return ""
-    rows = "".join(f"<tr><td>{status_badge('unreadable')}</td><td><code>{esc(u.path)}</code>"
+    rows = "".join(f"<tr><td>{status_badge('unreadable')}</td>"
+                   f"<td><code>{esc(shown_path(u.path, page))}</code>"
                    f"</td><td>{esc(u.why)}</td></tr>" for u in bad)
     return ('<h2 id="unreadable">Unreadable run folders</h2><p>These run folders have no usable '
             'result.json; they are not in any table or figure.</p><table class="data"><thead><tr>'
@@ -700,8 +729,9 @@ def footer_html(page: Page) -> str:
         ('<span id="noisy-timings">Noisy timings</span>', "a timing whose interquartile range "
          f"is above {100 * NOISY_IQR_FRACTION:.0f} % of its median is marked \u26a0 noisy "
          "wherever it is shown (image cards, the run table's frame, dynamic-frame and pass "
-         "times, the Pareto and equal-error tables, the animated-scene cost tables) and drawn "
-         "with a red square in the error-against-time and sweep figures (hatched in the "
+         "times, the Pareto and equal-error tables, the study's equal-time and equal-error "
+         "tables, the animated-scene cost tables) and drawn with a red square in the "
+         "error-against-time figures (the study's too) and sweep figures (hatched in the "
          "time-per-pass figure, its total starred). Its median is uncertain by about the IQR: two such "
          "times are only told apart when their IQRs do not overlap (see Noise). Timing more "
          "frames (the runner's timed frames) narrows it; on lavapipe (a CPU shared with other "
@@ -735,7 +765,10 @@ def footer_html(page: Page) -> str:
          "intervals (± 1σ; a point where no error bar is measured) do not overlap. A best run "
          "with another within its error bars is \u201cbest (tie)\u201d; a run whose IQR and "
          "error bar both overlap a front run's is a tie with the front; sweep summaries call a "
-         "change a rise or fall only beyond the bars."),
+         "change a rise or fall only beyond the larger of the scene's noise floor (the "
+         "HDR-FLIP of the reference's own noise, listed in the guide to HDR-FLIP at the top) "
+         "and the two ends' error bars and seed spread; smaller changes are \u201cunchanged "
+         "within noise\u201d."),
         ("Best run", "per technique and scene: the ok run with the lowest mean HDR-FLIP on the "
          "scene's ranking basis (ties: lower relMSE, then shorter frame time)."),
         ("Pareto front", "the runs for which no other run has both a frame time ≤ and an error "

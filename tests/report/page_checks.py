@@ -738,3 +738,250 @@ def check_verdict(checks: Any, dom: str) -> None:
     checks.check(bool(items) and all(": " in strip_tags(i) for i in items),
                  f"one verdict line per quality scene below the table ({len(items)})",
                  str(items[:2]))
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 48 ("everyday use, round 2"): one headline answer, the maps named for what they are,
+# the HDR-FLIP guide, sweeps within noise, noisy marks in the study, distinguishing
+# parameters, distinct header labels, no absolute paths
+# ---------------------------------------------------------------------------------------------
+
+def check_second_view(checks: Any, dom: str) -> None:
+    """With the study on the page, its verdict is the one headline: the per-technique
+    equal-time/error tables sit in a closed <details> under a heading that calls them a second
+    view and says how they differ; the cards' badge says 'lowest error', not 'best'."""
+    body = dom.split("</nav>", 1)[-1]
+    section = _section(body, '<h2 id="equal"', "<h2 ")
+    heading = strip_tags(re.search(r'<h2 id="equal">(.*?)</h2>', section, re.S).group(1)) \
+        if section else ""
+    folded = re.search(r'<details class="second-view"><summary>[^<]*</summary>(.*)</details>',
+                       section, re.S)
+    tables = len(re.findall(r'<table class="data ranking"', section))
+    inside = len(re.findall(r'<table class="data ranking"', folded.group(1))) if folded else 0
+    words = strip_tags(section.split("<details", 1)[0])
+    badges = [strip_tags(b) for b in re.findall(r'<span class="badge b-best[^"]*"[^>]*>(.*?)'
+                                                 r"</span>", body, re.S)]
+    checks.check('id="study"' in body and tables > 0 and inside == tables
+                 and "Which technique is best" not in heading and "second view" in heading
+                 and "verdict" in words and "series" in words and "budgets" in words
+                 and "open" not in section.split("<details", 1)[-1].split(">", 1)[0]
+                 and bool(badges) and all(b.startswith("lowest error") for b in badges),
+                 "one headline answer: the study's verdict; the per-technique equal-time/error "
+                 f"tables ({tables}) are folded in a closed <details> under a heading calling "
+                 "them a second view, which says how they differ (series, budgets); the card "
+                 "badge says 'lowest error'",
+                 f"heading '{heading}', {inside} of {tables} folded, badges {badges[:3]}")
+
+
+def full_map_counts(results_dir: str) -> tuple[int, int]:
+    """Measured runs with and without the runner's HDR-FLIP map vs the full reference on disk
+    (among those with a full reference)."""
+    with_map = without = 0
+    for key, data in results_by_key(results_dir).items():
+        if data.get("status") not in ("ok", "nonfinite") or not dig(data, "reference",
+                                                                     "full_png"):
+            continue
+        name = dig(data, "outputs", "flip_full_png")
+        folder = os.path.join(results_dir, "runs", key)
+        if name and os.path.isfile(os.path.join(folder, name)):
+            with_map += 1
+        else:
+            without += 1
+    return with_map, without
+
+
+def check_map_words(checks: Any, results_dir: str, dom: str) -> None:
+    """The images' intro says what the error maps against the full reference are: the
+    runner's HDR-FLIP maps for the runs that have them (counted), the report's own
+    relative-error words only for the others, and not at all when every run has its map."""
+    note = re.search(r'<p class="inspector-note">(.*?)</p>', dom, re.S)
+    text = strip_tags(note.group(1)) if note else ""
+    with_map, without = full_map_counts(results_dir)
+    flip = re.search(r'<span class="flip-maps">(\d+)</span>', note.group(1)) if note else None
+    own = re.search(r'<span class="own-maps">(\d+)</span>', note.group(1)) if note else None
+    shown = (int(flip.group(1)) if flip else 0, int(own.group(1)) if own else 0)
+    fallback = "It is not HDR-FLIP" in text
+    checks.check(with_map > 0 and shown == (with_map, without) and fallback == (without > 0)
+                 and "HDR-FLIP map" in text,
+                 f"the images' intro calls the full-reference error maps HDR-FLIP maps for the "
+                 f"{with_map} runs that have one and gives the report's own map's words only "
+                 f"for the {without} without",
+                 f"counted {shown}, fallback words {fallback}: {text[-400:]}")
+
+
+def _median(values: list[float]) -> Optional[float]:
+    values = sorted(values)
+    if not values:
+        return None
+    mid = len(values) // 2
+    return values[mid] if len(values) % 2 else 0.5 * (values[mid - 1] + values[mid])
+
+
+def scene_floors(results_dir: str) -> dict[str, Optional[float]]:
+    """scene -> median HDR-FLIP noise floor vs the full reference of its measured runs."""
+    values: dict[str, list[float]] = {}
+    for data in results_by_key(results_dir).values():
+        if data.get("status") not in ("ok", "nonfinite"):
+            continue
+        scene = dig(data, "scene", "label")
+        floor = dig(data, "metrics", "final_vs_full", "error_bars", "flip", "floor_mean")
+        values.setdefault(scene, [])
+        if isinstance(floor, (int, float)):
+            values[scene].append(float(floor))
+    return {scene: _median(v) for scene, v in values.items()}
+
+
+def check_flip_guide(checks: Any, results_dir: str, dom: str) -> None:
+    """A closed guide to HDR-FLIP sits on the first screen (after the verdict, before the
+    provenance table): the scale, each scene's noise floor (the median floor_mean of its runs,
+    'not recorded' without one) and why HDR-FLIP is about twice LDR FLIP on a dark scene."""
+    header = dom.split("</header>", 1)[0]
+    at, meta = header.find('id="flip-guide"'), header.find('class="meta"')
+    guide = header[at:meta] if 0 <= at < meta else ""
+    tag = re.search(r"<details[^>]*id=\"flip-guide\"[^>]*>", header)
+    problems = []
+    floors = scene_floors(results_dir)
+    for scene, floor in floors.items():
+        item = re.search(rf'<li data-scene="{re.escape(html.escape(scene))}">(.*?)</li>', guide,
+                         re.S)
+        if not item:
+            problems.append(f"{scene}: not listed")
+            continue
+        shown = re.search(r'class="floor" data-v="([^"]+)">([^<]+)<', item.group(1))
+        value = None if not shown or shown.group(1) == "None" else float(shown.group(1))
+        if (floor is None) != (value is None) or (floor is not None and not close(value, floor)) \
+                or (floor is None and "not recorded" not in shown.group(2)):
+            problems.append(f"{scene}: floor {shown and shown.group(2)}, expected {floor}")
+    words = strip_tags(guide)
+    checks.check(bool(guide) and tag is not None and " open" not in tag.group(0)
+                 and header.find('id="verdict"') < at and not problems
+                 and any(f is not None for f in floors.values())
+                 and all(w in words for w in ("0 (no visible difference)", "noise floor",
+                                              "LDR FLIP", "exposure", "brightened")),
+                 "the HDR-FLIP guide (closed, after the verdict, before the provenance) gives "
+                 "the scale, each scene's noise floor as recorded by its runs "
+                 f"({', '.join(f'{s}: {f}' for s, f in floors.items())}) and why HDR-FLIP "
+                 "reads about twice LDR FLIP on a dark scene", "; ".join(problems[:4]))
+
+
+def check_sweep_noise(checks: Any, results_dir: str, dom: str) -> None:
+    """A sweep summary on a scene with a noise floor calls a change of the HDR-FLIP within the
+    floor 'unchanged within noise (±floor', and only a larger one a fall or rise; the fixture
+    has both (cornell_box: pcf_radius changes by 0.003, cone_count by 0.15; floor 0.02)."""
+    floors = scene_floors(results_dir)
+    summaries = re.findall(r'<img [^>]*alt="sweep ([^ "]+) ([^"]+) ([^ "]+)"[^>]*></a>'
+                           r'<figcaption>.*?<ul class="trend">(.*?)</ul>', dom, re.S)
+    within, beyond, problems = 0, 0, []
+    for tech, scene, key, items in summaries:
+        floor = floors.get(html.unescape(scene))
+        if floor is None:
+            continue
+        for item in re.findall(r"<li>(.*?)</li>", items, re.S):
+            words = strip_tags(item).split("; frame time")[0]
+            values = [float(v) for v in re.findall(r"\b\d\.\d{4}\b", words)]
+            if len(values) < 2:
+                continue
+            change = abs(values[-1] - values[-2]) if "unchanged" in words else \
+                abs(values[1] - values[0])
+            if change <= floor:
+                within += 1
+                if f"unchanged within noise (±{floor:.4f}" not in words:
+                    problems.append(f"{tech} {key}: '{words}' (change {change:.4f})")
+            else:
+                beyond += 1
+                if not re.search(r"\b(falls|rises) from", words):
+                    problems.append(f"{tech} {key}: '{words}' (change {change:.4f})")
+    checks.check(within > 0 and beyond > 0 and not problems,
+                 f"sweep summaries: {within} HDR-FLIP changes within the scene's noise floor "
+                 f"say 'unchanged within noise (±floor)', {beyond} beyond it fall or rise",
+                 "; ".join(problems[:3]))
+
+
+def _noisy_time(data: dict, animated: bool) -> bool:
+    return _noisy(dig(data, "timing", "dynamic_frame_gpu_ms" if animated else "frame_gpu_ms"))
+
+
+def check_study_noisy(checks: Any, results_dir: str, dom: str) -> None:
+    """The study's figures draw a red square (SVG id noisy-time-<key>) on exactly the ranked runs
+    whose frame time is noisy, and its equal-time/error tables mark exactly those cells ⚠."""
+    runs = results_by_key(results_dir)
+    animated = animated_scenes(runs)
+    noisy = {k for k, d in runs.items() if d.get("status") == "ok"
+             and _noisy_time(d, dig(d, "scene", "label") in animated)}
+    fig_dir = os.path.join(results_dir, "figures")
+    marked: set[str] = set()
+    plotted: set[str] = set()
+    for name in os.listdir(fig_dir):
+        if name.startswith("study_"):
+            with open(os.path.join(fig_dir, name), encoding="utf-8") as f:
+                marked |= set(re.findall(r'id="noisy-time-([0-9a-f]+)"', f.read()))
+    shown = {html.unescape(s) for s in re.findall(r'<h3 class="study-scene">(.*?)</h3>', dom)}
+    plotted = {k for k in noisy if dig(runs[k], "scene", "label") in shown}
+    cells = re.findall(r'<table class="data study">.*?</table>', dom, re.S)
+    bad = [(k[:8], 'class="noisy"' in v) for t in cells
+           for k, v in re.findall(r'<td[^>]*data-key="([^"]+)"[^>]*>(.*?)</td>', t, re.S)
+           if ('class="noisy"' in v) != (k in noisy)]
+    marked_cells = sum(1 for t in cells for k, v in re.findall(
+        r'<td[^>]*data-key="([^"]+)"[^>]*>(.*?)</td>', t, re.S) if 'class="noisy"' in v)
+    checks.check(bool(plotted) and marked == plotted and not bad and marked_cells > 0,
+                 f"the study marks noisy timings: red squares on the {len(plotted)} noisy runs "
+                 f"in its figures, ⚠ in {marked_cells} table cells, nowhere else",
+                 f"figures {sorted(marked)}, noisy {sorted(plotted)}, cells {bad[:4]}")
+
+
+def check_key_params(checks: Any, results_dir: str, dom: str) -> None:
+    """Every card shows, outside '+ N more', each parameter whose value differs between the
+    runs of its technique (the fixture's tech_b `seed`, not swept, is 1 on one run), and
+    hides only the others."""
+    runs = results_by_key(results_dir)
+    values: dict[str, dict[str, set[str]]] = {}
+    for data in runs.values():
+        tech = dig(data, "technique", "id")
+        for k, v in (dig(data, "technique", "params") or {}).items():
+            values.setdefault(tech, {}).setdefault(k, set()).add(json.dumps(v))
+    problems, seen = [], 0
+    for key, part in cards(dom):
+        params = re.search(r'<div class="card-params">(.*?)</div>', part, re.S).group(1)
+        if "<details" not in params:
+            continue
+        seen += 1
+        head, hidden = params.split("<details", 1)
+        hidden = re.sub(r"<summary>.*?</summary>", " ", "<details" + hidden, flags=re.S)
+        tech = dig(runs[key], "technique", "id")
+        varying = {k for k, v in values[tech].items() if len(v) > 1}
+        shown = set(re.findall(r"([\w.]+)=", strip_tags(head)))
+        rest = set(re.findall(r"([\w.]+)=", strip_tags(hidden)))
+        if not varying <= shown or rest & varying:
+            problems.append(f"{key[:8]} ({tech}): shown {sorted(shown)}, hidden {sorted(rest)}")
+    seed_one = [k for k, d in runs.items() if dig(d, "technique", "params", "seed") == 1]
+    checks.check(seen > 0 and not problems and bool(seed_one)
+                 and any(k == s for k, _ in cards(dom) for s in seed_one),
+                 f"every card with '+ N more' ({seen}) shows the parameters that differ between "
+                 "its technique's runs (tech_b's seed) and hides only the others",
+                 "; ".join(problems[:3]))
+
+
+def check_header_labels(checks: Any, dom: str) -> None:
+    """The header's list of noisy timings never names two runs alike: two noisy tech_a runs on
+    cornell_box are told apart by their cone_count."""
+    row = re.search(r"<td>noisy timings</td><td>(.*?)</td></tr>", dom, re.S)
+    text = strip_tags(row.group(1)) if row else ""
+    labels = re.findall(r"(?:: |, )([\w#]+ on [\w#]+(?: \([^)]*=[^)]*\))?) \(", text)
+    checks.check(len(labels) >= 2 and len(set(labels)) == len(labels)
+                 and "tech_a on cornell_box (cone_count=2)" in labels,
+                 f"the header's noisy timings name each run once ({len(labels)}: "
+                 f"{', '.join(labels)})", text[:300])
+
+
+def check_no_absolute_paths(checks: Any, page_path: str, results_dirs: list[str],
+                            expected: list[str]) -> None:
+    """The page never contains the writing machine's absolute results path; the header's
+    results row shows each folder relative to the page (expected)."""
+    with open(page_path, encoding="utf-8") as f:
+        markup = f.read()
+    leaks = [d for d in results_dirs if os.path.abspath(d) in markup]
+    row = re.search(r"<td>results</td><td>(.*?)</td></tr>", markup, re.S)
+    shown = [strip_tags(p).strip() for p in row.group(1).split("<br>")] if row else []
+    checks.check(not leaks and shown == expected,
+                 f"no absolute results path on the page; the header shows {expected}",
+                 f"leaks {leaks}, header {shown}")

@@ -8,7 +8,8 @@ Builds fixtures (tests/report/make_fixture.py) in a temporary folder, runs the r
 and checks the page: files it links exist, it loads with no console message and no uncaught
 exception (and that this detection works, on a deliberately broken page), the run table has one
 row per run and sorts, figures and sections are there when they apply and absent when they don't,
-shards merge, an empty folder and a missing one are handled. Chromium logs every console message
+shards merge, an empty folder and a missing one are handled, and what the command tells the
+terminal about a folder that is not a results folder or is damaged (issue 48). Chromium logs every console message
 at one level (INFO:CONSOLE), so any console line fails the test: the report logs nothing unless
 something is broken (e.g. an image that does not load). Prints "N passed, M failed" last; exits 0
 only if nothing failed, 77 (ctest SKIP_RETURN_CODE) if Chromium is not installed.
@@ -260,6 +261,14 @@ def check_main(checks: Checks, tmp: str) -> None:
     page_checks.check_sweeps_apart(checks, fixture, dom)
     page_checks.check_noisy(checks, fixture, dom)
     page_checks.check_device_captions(checks, fixture, dom)
+    page_checks.check_second_view(checks, dom)
+    page_checks.check_map_words(checks, fixture, dom)
+    page_checks.check_flip_guide(checks, fixture, dom)
+    page_checks.check_sweep_noise(checks, fixture, dom)
+    page_checks.check_study_noisy(checks, fixture, dom)
+    page_checks.check_key_params(checks, fixture, dom)
+    page_checks.check_header_labels(checks, dom)
+    page_checks.check_no_absolute_paths(checks, page, [fixture], ["this folder (fixture/)"])
     checks.check("256^3 voxel grid needs 2.0 GiB" in dom, "the unsupported run's reason is shown")
     checks.check("0badc0ffee0badc0" in dom and "unreadable" in dom,
                  "the malformed run folder is listed as unreadable with its path")
@@ -408,6 +417,33 @@ def check_merge(checks: Checks, tmp: str) -> None:
                  str(missing_links(page)[:5]))
     checks.check(not os.path.exists(os.path.join(out, "figures", "stale.svg")),
                  "merge: figures of an earlier report are removed")
+    page_checks.check_no_absolute_paths(checks, page, shards, ["../shard0", "../shard1"])
+
+
+def check_all_maps(checks: Checks, tmp: str) -> None:
+    """A copy of the main fixture in which every run has its HDR-FLIP map against the full
+    reference: the images' intro must not describe the report's fallback map at all."""
+    out = os.path.join(tmp, "all-maps")
+    shutil.copytree(os.path.join(tmp, "fixture"), out,
+                    ignore=shutil.ignore_patterns("report.html", "figures", "maps"))
+    for key, data in page_checks.results_by_key(out).items():
+        folder = os.path.join(out, "runs", key)
+        if os.path.isfile(os.path.join(folder, "flip.png")) and \
+                not dig_outputs(data).get("flip_full_png"):
+            shutil.copy(os.path.join(folder, "flip.png"), os.path.join(folder, "flip_full.png"))
+            data["outputs"]["flip_full_png"] = "flip_full.png"
+            with open(os.path.join(folder, "result.json"), "w", encoding="utf-8") as f:
+                json.dump(data, f)
+    result = make_report([out])
+    page = os.path.join(out, "report.html")
+    checks.check(result.returncode == 0 and os.path.isfile(page), "all maps: report built",
+                 result.stderr[-600:])
+    dom = load_dom(checks, tmp, page, "all-maps page")
+    page_checks.check_map_words(checks, out, dom)
+
+
+def dig_outputs(data: dict) -> dict:
+    return data.get("outputs") if isinstance(data.get("outputs"), dict) else {}
 
 
 # Slurm job arrays: one folder, runs timed on two devices (each on its own node), or on one device
@@ -785,6 +821,60 @@ def check_edges(checks: Checks, tmp: str) -> None:
                  "missing folder: non-zero exit with a clear message", result.stderr)
 
 
+def write_result(root: str, name: str, text: str) -> None:
+    os.makedirs(os.path.join(root, "runs", name), exist_ok=True)
+    with open(os.path.join(root, "runs", name, "result.json"), "w", encoding="utf-8") as f:
+        f.write(text)
+
+
+GOOD_RUN = {"status": "ok", "key": "good", "scene": {"label": "s"}, "technique": {"id": "t"},
+            "outputs": {"final_png": "final.png"}}  # final.png is not written
+
+
+def check_cli(checks: Checks, tmp: str) -> None:
+    """What `gilab report` tells the terminal (no Chromium): the parent of results folders is
+    refused with the folders below it named and no page written; a damaged folder's skipped
+    files are each named with the reason and the page is still written from the rest; a folder
+    with nothing readable is refused."""
+    parent = os.path.join(tmp, "cli-parent")
+    os.makedirs(os.path.join(parent, "exp_a", "runs"))
+    os.makedirs(os.path.join(parent, "nested", "exp_b"))
+    open(os.path.join(parent, "nested", "exp_b", "results.jsonl"), "w").close()
+    result = make_report([parent])
+    checks.check(result.returncode == 2 and "found no runs in" in result.stderr
+                 and "exp_a" in result.stderr and os.path.join("nested", "exp_b") in result.stderr
+                 and not os.path.exists(os.path.join(parent, "report.html")),
+                 "the parent of results folders: exit 2, 'found no runs', the results folders "
+                 "below it named, no page written", f"{result.returncode}: {result.stderr}")
+    damaged = os.path.join(tmp, "cli-damaged")
+    write_result(damaged, "good", json.dumps(GOOD_RUN))
+    write_result(damaged, "truncated", '{"status": "ok", "key": "trunc')
+    write_result(damaged, "a_list", "[1, 2]")
+    os.makedirs(os.path.join(damaged, "runs", "empty_folder"))
+    with open(os.path.join(damaged, "results.jsonl"), "w", encoding="utf-8") as f:
+        f.write('{"key": "good"}\n{"key": "tru\n')
+    result = make_report([damaged])
+    err = result.stderr
+    checks.check(result.returncode == 0 and os.path.isfile(os.path.join(damaged, "report.html"))
+                 and "skipped 3 unreadable run folder" in err
+                 and all(f"{n}/result.json: {why}" in err for n, why in (
+                     ("truncated", "JSONDecodeError"), ("a_list", "result.json is not a JSON"),
+                     ("empty_folder", "no result.json")))
+                 and "good: final_png" in err and "results.jsonl: 1 line(s)" in err
+                 and "(line 2)" in err,
+                 "a damaged folder: the page is written from the readable run; each skipped "
+                 "file is named with why, the run lacking a listed file and the broken "
+                 "results.jsonl line too", err)
+    broken = os.path.join(tmp, "cli-broken")
+    write_result(broken, "truncated", '{"status": ')
+    result = make_report([broken])
+    checks.check(result.returncode == 2 and "no readable run" in result.stderr
+                 and "truncated/result.json" in result.stderr
+                 and not os.path.exists(os.path.join(broken, "report.html")),
+                 "nothing readable: exit 2 with the skipped file named, no page written",
+                 f"{result.returncode}: {result.stderr}")
+
+
 def main(argv: list[str]) -> int:
     if not os.access(CHROMIUM, os.X_OK):
         print(f"SKIP: {CHROMIUM} not found (apt-get install chromium)")
@@ -794,8 +884,8 @@ def main(argv: list[str]) -> int:
     start = time.monotonic()
     # Chains in parallel threads (Chromium mostly waits): the merge needs the main fixture,
     # check_devices the flat one.
-    chains = [[check_main, check_merge], [check_no_sweeps, check_devices],
-              [check_detection, check_hostile, check_edges, check_inspector]]
+    chains = [[check_main, check_merge, check_all_maps], [check_no_sweeps, check_devices],
+              [check_detection, check_hostile, check_edges, check_cli, check_inspector]]
     results: dict[str, Checks] = {}
 
     def run_chain(steps: list) -> None:

@@ -511,5 +511,28 @@ class Formatting(unittest.TestCase):
                          ["0.123", "1230", "1.23e-04", "0", "—", "45.0", "1.00"])
 
 
+class SweepLines(unittest.TestCase):
+    """A sweep's lines never join runs that differ in an unswept parameter (the study's vct
+    blocks at two `lift` values drew "from diffuse_cones=3 to 3"); seeds stay one line."""
+
+    @staticmethod
+    def make_run(cones, lift, seed=0):
+        from types import SimpleNamespace
+        return SimpleNamespace(measured=True, technique="vct", scene="a",
+                               swept={"diffuse_cones": str(cones)},
+                               params={"diffuse_cones": cones, "lift": lift, "seed": seed,
+                                       "voxel_resolution": 64})
+
+    def test_unswept_parameter_splits_lines_and_seed_does_not(self):
+        from gilab_report.analysis import find_sweeps
+        runs = [self.make_run(3, 1.5), self.make_run(6, 1.5), self.make_run(3, 0.5), self.make_run(6, 0.5),
+                self.make_run(6, 0.5, seed=2)]
+        (sweep,) = find_sweeps(runs)
+        self.assertEqual(sweep.key, "diffuse_cones")
+        self.assertEqual(sweep.other_keys, ["lift"])
+        lines = {k: [r.params["diffuse_cones"] for r in v] for k, v in sweep.series.items()}
+        self.assertEqual(lines, {("0.5",): [3, 6, 6], ("1.5",): [3, 6]})
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=1)

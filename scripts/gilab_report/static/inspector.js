@@ -6,10 +6,25 @@
   if (!box || !dataNode) { return; }
   var data = JSON.parse(dataNode.textContent);
   var img = box.querySelector(".ins-img"), view = box.querySelector(".ins-view");
+  // panX/panY: the image's top-left corner in the view (CSS px); client: the cursor's last
+  // position over the image, pointer: over the view (client coordinates, null when outside).
   var state = { group: null, layers: [], layer: 0, zoom: 1, w: 0, h: 0, x: -1, y: -1,
-                section: null, opener: null };
-  var decoded = {};
+                section: null, opener: null, panX: 0, panY: 0, client: null, pointer: null,
+                drag: null, wheel: 0, wheelAt: 0 };
+  var decoded = {}, decodedMaps = {};
   var ZOOMS = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32, 48, 64];
+  var KEEP = 32;  // px of the image that panning keeps inside the view
+  var WHEEL_STEP = 50;  // px of wheel travel (a mouse's notch is 100 or 120) per zoom step
+
+  // The colour bar of error maps (legend from the page's data: metric, range, colour stops).
+  var legend = document.createElement("div");
+  legend.className = "ins-legend";
+  legend.hidden = true;
+  legend.innerHTML = '<span class="ins-legend-name"></span><span class="ins-legend-min"></span>' +
+    '<span class="ins-legend-bar"><i class="ins-legend-mark" hidden></i></span>' +
+    '<span class="ins-legend-max"></span>';
+  var file = box.querySelector(".ins-file");
+  file.parentNode.insertBefore(legend, file.nextSibling);
 
   function half(bits) {
     var sign = (bits & 0x8000) ? -1 : 1, e = (bits >> 10) & 0x1f, f = bits & 0x3ff;
@@ -33,6 +48,29 @@
     return decoded[id];
   }
 
+  // An error map's values read back from its PNG: one byte k per pixel (value k / 255).
+  function mapValues(id) {
+    if (!id || !data.maps || !data.maps[id]) { return null; }
+    if (decodedMaps[id]) { return decodedMaps[id]; }
+    var entry = data.maps[id], bin = atob(entry.b64), codes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) { codes[i] = bin.charCodeAt(i); }
+    var bad = {};
+    (entry.bad || []).forEach(function (p) { bad[p] = true; });
+    decodedMaps[id] = { w: entry.w, h: entry.h, k: codes, bad: bad, dev: entry.dev || 0 };
+    return decodedMaps[id];
+  }
+
+  // The map's value at the inspector's pixel (x, y) (scaled when the map's size differs):
+  // null outside, NaN where the map has no value.
+  function mapAt(id, x, y) {
+    var map = mapValues(id);
+    if (!map || x < 0 || y < 0 || x >= state.w || y >= state.h) { return null; }
+    var mx = map.w === state.w ? x : Math.floor(x * map.w / state.w);
+    var my = map.h === state.h ? y : Math.floor(y * map.h / state.h);
+    var p = my * map.w + mx;
+    return map.bad[p] ? NaN : map.k[p] / 255;
+  }
+
   function rgbAt(id, x, y) {
     var lin = linear(id);
     if (!lin || x < 0 || y < 0 || x >= lin.w || y >= lin.h) { return null; }
@@ -53,7 +91,16 @@
       return ["|ΔY| / mean Y = " + fmt(e), [e]];
     }
     if (layer.kind === "map") {
-      return ["colour only (the map's values are not stored)", null];
+      if (!layer.q) {
+        return ["colour only" + (layer.why ? " (no values: " + layer.why + ")" : ""), null];
+      }
+      var v = mapAt(layer.q, x, y), map = mapValues(layer.q);
+      if (v === null) { return ["no value", null]; }
+      if (isNaN(v)) { return ["no value (not a colour of the map: NaN is magenta)", null]; }
+      var metric = layer.legend ? layer.legend.metric : "value";
+      return [metric + " = " + fmt(v) + (map.dev
+        ? " (≈: the PNG's colours are up to " + map.dev + "/255 off the runner's magma)"
+        : " (±0.002: read back from the PNG's 8-bit colour)"), [v]];
     }
     var rgb = rgbAt(layer.lin, x, y);
     if (!rgb) { return ["no linear values" + (layer.why ? ": " + layer.why : ""), null]; }
@@ -67,6 +114,18 @@
     return null;
   }
 
+  // The legend's marker at value v (hidden when v is not a number).
+  function mark(v) {
+    var layer = state.layers[state.layer], marker = legend.querySelector(".ins-legend-mark");
+    if (!layer || !layer.legend || typeof v !== "number" || !isFinite(v)) {
+      marker.hidden = true;
+      return;
+    }
+    var f = (v - layer.legend.min) / (layer.legend.max - layer.legend.min);
+    marker.style.left = (100 * Math.max(0, Math.min(1, f))).toFixed(2) + "%";
+    marker.hidden = false;
+  }
+
   function show() {
     var x = state.x, y = state.y, layer = state.layers[state.layer];
     var pos = box.querySelector(".ins-pos"), out = box.querySelector(".ins-value");
@@ -74,20 +133,43 @@
     if (x < 0 || y < 0 || x >= state.w || y >= state.h) {
       pos.textContent = "move the cursor over the image";
       out.textContent = ""; more.textContent = ""; out.removeAttribute("data-v");
+      mark(null);
       return;
     }
     var value = valueOf(layer, x, y);
     pos.textContent = "pixel (" + x + ", " + y + ")";
     out.textContent = layer.name + ": " + value[0];
     out.setAttribute("data-v", value[1] ? value[1].join(" ") : "");
+    mark(layer.legend && value[1] ? value[1][0] : null);
     var others = [];
     state.layers.forEach(function (other, i) {
-      if (i !== state.layer && other.kind === "image" && other.lin) {
+      if (i === state.layer) { return; }
+      if (other.kind === "image" && other.lin) {
         var rgb = rgbAt(other.lin, x, y);
         if (rgb) { others.push(other.name + ": " + fmtRgb(rgb)); }
+      } else if (other.kind === "relerr" || (other.kind === "map" && other.q)) {
+        var e = valueOf(other, x, y)[1];
+        if (e) { others.push(other.name + ": " + fmt(e[0])); }
       }
     });
     more.textContent = others.join(" · ");
+  }
+
+  function showLegend(layer) {
+    var spec = layer.legend;
+    legend.hidden = !spec;
+    box.setAttribute("data-legend", spec ? spec.metric : "");
+    if (!spec) { return; }
+    legend.querySelector(".ins-legend-name").textContent = spec.metric;
+    legend.querySelector(".ins-legend-min").textContent = spec.minLabel;
+    legend.querySelector(".ins-legend-max").textContent = spec.maxLabel;
+    legend.title = spec.metric + " from " + spec.minLabel + " to " + spec.maxLabel +
+      (spec.note ? ": " + spec.note : "");
+    var stops = (data.cmaps && data.cmaps[spec.cmap]) || [];
+    legend.querySelector(".ins-legend-bar").style.background = stops.length
+      ? "linear-gradient(to right, " + stops.map(function (s) {
+        return s[1] + " " + (100 * s[0]).toFixed(2) + "%";
+      }).join(", ") + ")" : "";
   }
 
   function exposure() {
@@ -110,21 +192,55 @@
       buttons[i].className = i === state.layer ? "on" : "";
     }
     box.setAttribute("data-layer", layer.name);
+    showLegend(layer);
     show();
   }
 
-  function setZoom(factor) {
-    state.zoom = Math.max(ZOOMS[0], Math.min(ZOOMS[ZOOMS.length - 1], factor));
-    img.style.width = (state.w * state.zoom) + "px";
-    img.style.height = (state.h * state.zoom) + "px";
-    box.querySelector(".ins-factor").textContent = state.zoom + "×";
-    box.setAttribute("data-zoom", String(state.zoom));
+  // The image at (panX, panY) in the view, drawn zoom CSS px per pixel.
+  function place() {
+    img.style.left = state.panX + "px";
+    img.style.top = state.panY + "px";
   }
 
-  function step(direction) {
+  // Keeps at least KEEP px (or all) of the image inside the view.
+  function clampPan() {
+    var vw = view.clientWidth, vh = view.clientHeight;
+    var iw = state.w * state.zoom, ih = state.h * state.zoom;
+    var kx = Math.min(KEEP, iw), ky = Math.min(KEEP, ih);
+    state.panX = Math.max(kx - iw, Math.min(vw - kx, state.panX));
+    state.panY = Math.max(ky - ih, Math.min(vh - ky, state.panY));
+  }
+
+  // Zoom to `factor` keeping the image point under (clientX, clientY) where it is on screen
+  // (the view's centre when no point is given; then the image is also kept in view).
+  function setZoom(factor, clientX, clientY) {
+    var z = Math.max(ZOOMS[0], Math.min(ZOOMS[ZOOMS.length - 1], factor));
+    var rect = view.getBoundingClientRect(), anchored = typeof clientX === "number";
+    var ax = anchored ? clientX - rect.left - view.clientLeft : view.clientWidth / 2;
+    var ay = anchored ? clientY - rect.top - view.clientTop : view.clientHeight / 2;
+    var u = (ax - state.panX) / state.zoom, v = (ay - state.panY) / state.zoom;
+    state.panX = Math.round(ax - u * z);
+    state.panY = Math.round(ay - v * z);
+    state.zoom = z;
+    if (!anchored) { clampPan(); }
+    img.style.width = (state.w * z) + "px";
+    img.style.height = (state.h * z) + "px";
+    place();
+    box.querySelector(".ins-factor").textContent = z + "×";
+    box.setAttribute("data-zoom", String(z));
+    if (state.client) { pointAt(state.client[0], state.client[1]); }
+  }
+
+  function step(direction, clientX, clientY) {
     var i = ZOOMS.indexOf(state.zoom);
     if (i < 0) { i = 0; }
-    setZoom(ZOOMS[Math.max(0, Math.min(ZOOMS.length - 1, i + direction))]);
+    setZoom(ZOOMS[Math.max(0, Math.min(ZOOMS.length - 1, i + direction))], clientX, clientY);
+  }
+
+  // A zoom step about the cursor when it is over the view, else about the view's centre.
+  function stepAtPointer(direction) {
+    if (state.pointer) { step(direction, state.pointer[0], state.pointer[1]); }
+    else { step(direction); }
   }
 
   function fit() {
@@ -132,6 +248,9 @@
     ZOOMS.forEach(function (z) {
       if (state.w * z <= width - 8 && state.h * z <= height - 8) { best = Math.max(best, z); }
     });
+    state.zoom = best;
+    state.panX = Math.round((width - state.w * best) / 2);
+    state.panY = Math.round((height - state.h * best) / 2);
     setZoom(best);
   }
 
@@ -143,9 +262,10 @@
     state.opener = opener || null;
     state.section = opener && opener.closest ? opener.closest("section") : null;
     state.x = -1; state.y = -1;
+    state.client = null; state.pointer = null; state.drag = null;
     var size = null;
     group.layers.forEach(function (layer) {
-      var lin = linear(layer.lin || layer.a);
+      var lin = linear(layer.lin || layer.a) || mapValues(layer.q);
       if (!size && lin) { size = [lin.w, lin.h]; }
     });
     if (!size && opener) { size = [opener.naturalWidth || 0, opener.naturalHeight || 0]; }
@@ -177,6 +297,7 @@
   function pointAt(clientX, clientY) {
     var rect = img.getBoundingClientRect();
     if (!rect.width || !rect.height) { return; }
+    state.client = [clientX, clientY];
     state.x = Math.floor((clientX - rect.left) * state.w / rect.width);
     state.y = Math.floor((clientY - rect.top) * state.h / rect.height);
     show();
@@ -188,8 +309,8 @@
     else if (name === "ArrowRight" || name === " " || name === "Spacebar" || name === "n") {
       setLayer(state.layer + 1);
     } else if (name === "ArrowLeft" || name === "p") { setLayer(state.layer - 1); }
-    else if (name === "+" || name === "=") { step(1); }
-    else if (name === "-" || name === "_") { step(-1); }
+    else if (name === "+" || name === "=") { stepAtPointer(1); }
+    else if (name === "-" || name === "_") { stepAtPointer(-1); }
     else if (name === "0") { fit(); }
     else if (/^[1-9]$/.test(name) && Number(name) <= state.layers.length) {
       setLayer(Number(name) - 1);
@@ -209,7 +330,49 @@
     if (key(event.key)) { event.preventDefault(); }
   });
   img.addEventListener("mousemove", function (event) { pointAt(event.clientX, event.clientY); });
-  img.addEventListener("mouseleave", function () { state.x = -1; state.y = -1; show(); });
+  img.addEventListener("mouseleave", function () {
+    state.x = -1; state.y = -1; state.client = null; show();
+  });
+  view.addEventListener("mousemove", function (event) {
+    state.pointer = [event.clientX, event.clientY];
+  });
+  view.addEventListener("mouseleave", function () { state.pointer = null; });
+  // The wheel zooms about the cursor: one step per WHEEL_STEP px of travel (a notch).
+  view.addEventListener("wheel", function (event) {
+    if (box.hidden) { return; }
+    event.preventDefault();
+    var unit = event.deltaMode === 1 ? 40 : event.deltaMode === 2 ? 800 : 1;
+    var now = Date.now();
+    if (now - state.wheelAt > 400) { state.wheel = 0; }
+    state.wheelAt = now;
+    state.wheel += event.deltaY * unit;
+    state.pointer = [event.clientX, event.clientY];
+    if (Math.abs(state.wheel) >= WHEEL_STEP) {
+      step(state.wheel < 0 ? 1 : -1, event.clientX, event.clientY);
+      state.wheel = 0;
+    }
+  }, { passive: false });
+  // Dragging pans.
+  view.addEventListener("mousedown", function (event) {
+    if (event.button !== 0) { return; }
+    event.preventDefault();
+    state.drag = [event.clientX, event.clientY, state.panX, state.panY];
+    view.classList.add("dragging");
+  });
+  document.addEventListener("mousemove", function (event) {
+    if (!state.drag) { return; }
+    state.panX = state.drag[2] + event.clientX - state.drag[0];
+    state.panY = state.drag[3] + event.clientY - state.drag[1];
+    clampPan();
+    place();
+  });
+  document.addEventListener("mouseup", function () {
+    state.drag = null;
+    view.classList.remove("dragging");
+  });
+  window.addEventListener("resize", function () {
+    if (!box.hidden) { clampPan(); place(); }
+  });
   box.querySelector(".ins-close").addEventListener("click", close);
   box.querySelector("[data-zoom=in]").addEventListener("click", function () { step(1); });
   box.querySelector("[data-zoom=out]").addEventListener("click", function () { step(-1); });
