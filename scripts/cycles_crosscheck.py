@@ -16,7 +16,14 @@ round (it removes set-up both renderers repeat per render: Cycles' scene sync an
 file writes). The same with CPU time (every thread). The ratio gilab / Cycles is taken per round
 (the machine's speed drifts between rounds; the renderers of one round ran interleaved).
 
+With --ladder (issue 49) nothing is extrapolated: each renderer renders seed pairs on a ladder
+of sample counts until one reaches relMSE 1e-3; the count where it is reached is interpolated
+between the two rungs that bracket it (samples_to_target); then both render seed pairs at their
+count in interleaved rounds, and the relMSE, the marginal cost and the time to 1e-3 are measured
+there (analyse_final). The old extrapolation from the first rung is reported beside it.
+
 usage: cycles_crosscheck.py OUT_DIR   (reads OUT_DIR/runs.json written by the shell script)
+       cycles_crosscheck.py --ladder-status OUT_DIR   (between rungs: which ladders are done)
 Writes OUT_DIR/crosscheck.json and OUT_DIR/crosscheck.md.
 """
 import json
@@ -66,6 +73,108 @@ def weighted_mean(renders):
 def per_sample_mse(x1, x2, n, y):
     """a from a seed pair of n samples each (module docstring)."""
     return n * float(np.mean((x1 - x2) ** 2 / (y * y + EPS))) / 2.0
+
+
+def rel_mse_pair(x1, x2, y):
+    """The relative MSE of ONE of two independent renders x1, x2 of the same n samples (its
+    variance: E[(x1 - x2)^2] / 2), weighted as gilab's relMSE. Measured at n, no 1/n law."""
+    return float(np.mean((x1 - x2) ** 2 / (y * y + EPS))) / 2.0
+
+
+def samples_to_target(rungs, target=TARGET):
+    """The sample count whose relMSE is `target`, from a ladder of measured (n, relMSE) rungs:
+    interpolated in log-log between the last rung above the target and the first at or below
+    it, so between two measured counts and never beyond them. Returns (n, slope) with slope
+    = -d log relMSE / d log n of that bracket (1 for a 1/n law), or None while no rung reaches
+    the target. A ladder whose first rung already reaches it has no bracket: start it lower."""
+    rungs = sorted(rungs)
+    for k, (n, e) in enumerate(rungs):
+        if e > target:
+            continue
+        if k == 0:
+            raise ValueError(f"the ladder's first rung ({n} spp, relMSE {e:.3g}) is already at "
+                             f"or below {target:g}: start it lower")
+        (n0, e0), (n1, e1) = rungs[k - 1], (n, e)
+        slope = -np.log(e1 / e0) / np.log(n1 / n0)
+        if not slope > 0:
+            raise ValueError(f"relMSE does not fall between {n0} and {n1} spp "
+                             f"({e0:.3g} -> {e1:.3g}): render more seed pairs per rung")
+        return float(n0 * (e0 / target) ** (1.0 / slope)), float(slope)
+    return None
+
+
+def ladder_rungs(renders, renderer, stage="ladder"):
+    """(n, relMSE) per rung of one renderer's ladder: its seed pairs at each count, weights
+    from every render of both renderers outside the pair's rung (as `analyse`)."""
+    pairs = [r for r in renders if r.get("stage") == stage and r["spp"] > 1]
+    rungs = []
+    for n in sorted({r["spp"] for r in pairs if r["renderer"] == renderer}):
+        mine = [r for r in pairs if r["renderer"] == renderer and r["spp"] == n]
+        if len(mine) % 2:
+            sys.exit(f"cycles_crosscheck: {renderer}'s rung {n} spp has {len(mine)} renders, "
+                     "not seed pairs")
+        others = [r for r in renders if r["spp"] > 1 and r not in mine]
+        y = weighted_mean(others) if others else weighted_mean(mine)
+        e = [rel_mse_pair(a["image"], b["image"], y) for a, b in zip(mine[::2], mine[1::2])]
+        rungs.append((n, float(np.mean(e))))
+    return rungs
+
+
+def analyse_final(renders, target=TARGET):
+    """The measurement at the target (issue 49): per renderer, its ladder's count n* (rungs
+    bracketing the target) and the seed pairs rendered at n* in interleaved rounds; per round
+    the relMSE measured at n*, the marginal s/spp and the time to the target, n* x s/spp scaled
+    by the bracket's local law to the measured relMSE (a correction of a few per cent, inside the
+    measured range); the ratios gilab / Cycles per round; and, beside them, what the old
+    extrapolation (a = n relMSE at n*, times a / target) gives from the same renders."""
+    final = [r for r in renders if r.get("stage") == "final"]
+    rows = []
+    for renderer in ("gilab", "cycles"):
+        rungs = ladder_rungs(renders, renderer)
+        try:
+            found = samples_to_target(rungs, target)
+        except ValueError as e:
+            sys.exit(f"cycles_crosscheck: {renderer}: {e}")
+        if found is None:
+            sys.exit(f"cycles_crosscheck: {renderer}'s ladder never reached relMSE {target:g}")
+        n_star, slope = found
+        # The old method: a = n relMSE(n) at the ladder's first rung, stretched by 1/n
+        old_spp = rungs[0][0] * rungs[0][1] / target
+        for rnd in sorted({r["round"] for r in final}):
+            pair = [r for r in final if r["renderer"] == renderer and r["round"] == rnd
+                    and r["spp"] > 1]
+            setup = [r for r in final if r["renderer"] == renderer and r["round"] == rnd
+                     and r["spp"] == 1]
+            if len(pair) != 2 or len(setup) != 1:
+                sys.exit(f"cycles_crosscheck: final round {rnd} lacks {renderer}'s seed pair "
+                         "or its 1-sample render")
+            n = pair[0]["spp"]
+            y = weighted_mean([r for r in final if r["spp"] > 1 and r not in pair])
+            e = rel_mse_pair(pair[0]["image"], pair[1]["image"], y)
+            wall = float(np.mean([(r["seconds"] - setup[0]["seconds"]) / (n - 1) for r in pair]))
+            cpu = float(np.mean([(r["cpu_seconds"] - setup[0]["cpu_seconds"]) / (n - 1)
+                                 for r in pair]))
+            n_target = n * (e / target) ** (1.0 / slope)
+            rows.append({"renderer": renderer, "round": rnd, "spp": n, "ladder_spp": n_star,
+                         "ladder_slope": slope, "seeds": [r["seed"] for r in pair],
+                         "rel_mse": e, "spp_to_target": n_target, "s_per_spp": wall,
+                         "cpu_s_per_spp": cpu, "setup_seconds": setup[0]["seconds"],
+                         "seconds_to_target": n_target * wall,
+                         "cpu_seconds_to_target": n_target * cpu,
+                         "extrapolated_spp": old_spp, "extrapolated_seconds": old_spp * wall})
+    ratios = []
+    for rnd in sorted({r["round"] for r in rows}):
+        g = next(r for r in rows if r["renderer"] == "gilab" and r["round"] == rnd)
+        c = next(r for r in rows if r["renderer"] == "cycles" and r["round"] == rnd)
+        ratios.append({"round": rnd,
+                       "wall": g["seconds_to_target"] / c["seconds_to_target"],
+                       "cpu": g["cpu_seconds_to_target"] / c["cpu_seconds_to_target"],
+                       "spp": g["spp_to_target"] / c["spp_to_target"],
+                       "s_per_spp": g["s_per_spp"] / c["s_per_spp"],
+                       "extrapolated_wall": g["extrapolated_seconds"] / c["extrapolated_seconds"]})
+    spread = {k: [min(q[k] for q in ratios), max(q[k] for q in ratios)]
+              for k in ("wall", "cpu", "spp", "s_per_spp", "extrapolated_wall")}
+    return rows, ratios, spread
 
 
 def analyse(renders):
@@ -183,7 +292,63 @@ def markdown(meta, rows, ratios, spread, agree):
     return "\n".join(lines) + "\n"
 
 
+def markdown_final(meta, ladders, rows, ratios, spread, agree, target=TARGET):
+    """crosscheck.md of a ladder run (--ladder): the rungs, the rounds at the target, the ratios
+    with the old extrapolation beside them, and the agreement."""
+    lines = [f"# Cycles cross-check at relMSE {target:g}: {meta['scene']} ({meta['width']}x"
+             f"{meta['height']}, {meta['max_bounces']} bounces, {meta['threads']} threads)", "",
+             f"gilab reference path tracer v{meta['gilab_version']} ({meta['gilab_sampler']} "
+             f"sampler) vs Blender {meta['blender_version']} Cycles (CPU, its defaults). "
+             f"Machine: {meta['machine']}; {meta['date']}; seeds from {meta.get('seed_base', 1)}.",
+             "", "Ladder: relMSE of one render (from seed pairs), per sample count:", ""]
+    for renderer, rungs in ladders.items():
+        lines.append(f"- {renderer}: " + ", ".join(f"{n} spp {e:.4g}" for n, e in rungs))
+    lines += ["", f"{len(ratios)} rounds at the ladder's count, each: gilab pair, Cycles pair, "
+              "one 1-sample render each (set-up). Time to the target = spp to the target x the "
+              "marginal s/spp; spp to the target = the rendered count scaled by the ladder's "
+              "local law to the relMSE measured in the round.", "",
+              f"| round | renderer | spp | relMSE measured | spp to {target:g} | s/spp (wall) | "
+              f"CPU s/spp | time to {target:g} | old extrapolation |",
+              "|---:|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for r in sorted(rows, key=lambda r: (r["round"], r["renderer"] != "gilab")):
+        lines.append(f"| {r['round']} | {r['renderer']} | {r['spp']} | {r['rel_mse']:.4g} | "
+                     f"{r['spp_to_target']:.0f} | {r['s_per_spp']:.4f} | "
+                     f"{r['cpu_s_per_spp']:.4f} | {r['seconds_to_target']:.1f} s | "
+                     f"{r['extrapolated_seconds']:.1f} s ({r['extrapolated_spp']:.0f} spp) |")
+    lines += ["", f"| round | gilab / Cycles: wall time to {target:g} | CPU time | spp | s/spp | "
+              "old extrapolation (wall) |", "|---:|---:|---:|---:|---:|---:|"]
+    for q in ratios:
+        lines.append(f"| {q['round']} | **{q['wall']:.3f}** | **{q['cpu']:.3f}** | "
+                     f"{q['spp']:.3f} | {q['s_per_spp']:.3f} | {q['extrapolated_wall']:.3f} |")
+    lines.append("| spread | " + " | ".join(
+        f"{spread[k][0]:.3f}–{spread[k][1]:.3f}"
+        for k in ("wall", "cpu", "spp", "s_per_spp", "extrapolated_wall")) + " |")
+    lum = agree["ratio_cycles_over_gilab"][3], agree["ratio_sigma"][3]
+    lines += ["", f"Agreement (the rounds' samples pooled): mean luminance Cycles / gilab "
+              f"{lum[0]:.4f} ± {lum[1]:.4f}; relMSE between them {agree['rel_mse']:.4g}, of "
+              f"which noise {agree['rel_mse_expected_noise']:.4g}."]
+    return "\n".join(lines) + "\n"
+
+
+def ladder_status(out):
+    """For the shell script between rungs: one line per renderer, `NAME N SLOPE` once its
+    ladder brackets the target (N = the count to render), else `NAME -`. Exit 1 when a ladder
+    cannot bracket it (its first rung is already below the target)."""
+    meta = json.load(open(os.path.join(out, "runs.json")))
+    renders = [load_render(out, r) for r in meta["runs"]]
+    target = float(meta.get("target", TARGET))
+    for renderer in ("gilab", "cycles"):
+        try:
+            found = samples_to_target(ladder_rungs(renders, renderer), target)
+        except ValueError as e:
+            sys.exit(f"cycles_crosscheck: {renderer}: {e}")
+        print(f"{renderer} -" if found is None else f"{renderer} {found[0]:.1f} {found[1]:.4f}")
+    return 0
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--ladder-status":
+        return ladder_status(sys.argv[2])
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     out = sys.argv[1]
@@ -194,9 +359,17 @@ def main():
     meta.update({"gilab_version": gilab_info["renderer"]["version"],
                  "gilab_sampler": gilab_info["settings"]["sampler"],
                  "blender_version": cycles_info["blender_version"]})
-    rows, ratios, spread = analyse(renders)
-    agree = agreement(renders)
-    text = markdown(meta, rows, ratios, spread, agree)
+    if any(r.get("stage") == "final" for r in renders):  # --ladder (issue 49)
+        target = float(meta.get("target", TARGET))
+        ladders = {k: ladder_rungs(renders, k) for k in ("gilab", "cycles")}
+        rows, ratios, spread = analyse_final(renders, target)
+        agree = agreement([r for r in renders if r.get("stage") == "final"])
+        text = markdown_final(meta, ladders, rows, ratios, spread, agree, target)
+        meta["ladders"] = ladders
+    else:
+        rows, ratios, spread = analyse(renders)
+        agree = agreement(renders)
+        text = markdown(meta, rows, ratios, spread, agree)
     print(text, end="")
     with open(os.path.join(out, "crosscheck.md"), "w") as f:
         f.write(text)

@@ -17,22 +17,30 @@
 #
 # usage: scripts/cycles_crosscheck.sh [--scene cornell|sponza] [--rounds R] [--gilab-spp N]
 #          [--cycles-spp N] [--threads T] [--out DIR] [--gilab-sampler independent|sobol]
+#          [--ladder N] [--seed-base S] [--target E]
 #   cornell (default): McGuire's Cornell box glTF, 256x256, 64 bounces, gilab 1024 / Cycles 512 spp
 #   sponza: Dabrovic Sponza, the sun of scenes/sponza.json, 256x144, 16 bounces, textured,
 #           gilab 256 / Cycles 128 spp
 #   --rounds: repeats of the interleaved seed pairs (default 2; the ratio's spread needs >= 2)
+#   --ladder N: measure at relMSE 1e-3 instead of extrapolating to it (issue 49): seed pairs of
+#       both renderers at N, 2N, 4N, ... spp until each reaches 1e-3 (the count is interpolated
+#       between the two rungs around it), then --rounds (at least 4) interleaved rounds of seed
+#       pairs at that count; --gilab-spp and --cycles-spp are not used
+#   --seed-base S: first seed (default: from the clock, so every sitting draws new seeds)
+#   --target E: the relMSE the ladder measures at (default 1e-3; larger only for a quick try)
 #   env GILAB: the gilab binary (default build/gilab)
 # tiny test: scripts/cycles_crosscheck.sh --rounds 2 --gilab-spp 8 --cycles-spp 8 --out /tmp/x
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-scene=cornell rounds=2 gilab_spp="" cycles_spp="" threads=2 sampler=independent
+scene=cornell rounds="" gilab_spp="" cycles_spp="" threads=2 sampler=independent ladder=""
+seed_base=$(( $(date +%s) % 1000000 * 100 )) target=1e-3
 out=""
 gilab=${GILAB:-$root/build/gilab}
 py=/usr/bin/python3
 
 die() { echo "cycles_crosscheck: $*" >&2; exit 1; }
-usage() { sed -n '18,26p' "$0"; exit "${1:-2}"; }
+usage() { sed -n '18,33p' "$0"; exit "${1:-2}"; }
 
 while [[ $# -gt 0 ]]; do
     [[ $1 == -h || $1 == --help ]] && usage 0
@@ -45,6 +53,9 @@ while [[ $# -gt 0 ]]; do
         --threads) threads=$2 ;;
         --out) out=$2 ;;
         --gilab-sampler) sampler=$2 ;;
+        --ladder) ladder=$2 ;;
+        --seed-base) seed_base=$2 ;;
+        --target) target=$2 ;;
         *) echo "unknown option $1" >&2; usage ;;
     esac
     shift 2
@@ -65,6 +76,15 @@ esac
 : "${out:=results/cycles_crosscheck/$scene}"
 [[ $sampler == independent || $sampler == sobol ]] ||
     die "--gilab-sampler takes independent or sobol"
+if [[ -n $ladder ]]; then
+    : "${rounds:=4}"
+    [[ $ladder =~ ^[1-9][0-9]*$ && $ladder -ge 2 ]] || die "--ladder takes a count >= 2"
+    [[ $rounds -ge 4 ]] || die "--ladder needs --rounds 4 or more (seed pairs at the target)"
+else
+    : "${rounds:=2}"
+fi
+[[ $seed_base =~ ^[0-9]+$ ]] || die "--seed-base takes a non-negative integer"
+[[ $target =~ ^[0-9.]+(e-?[0-9]+)?$ ]] || die "--target takes a relMSE such as 1e-3"
 for v in "$rounds" "$threads" "$gilab_spp" "$cycles_spp"; do
     [[ $v =~ ^[1-9][0-9]*$ ]] || die "not a positive integer: $v"
 done
@@ -130,9 +150,59 @@ cycles_render() {  # spp seed name
 
 # The rounds, interleaved; runs.json lists every render for the analysis
 runs=()
-add_run() { runs+=("{\"renderer\": \"$1\", \"round\": $2, \"seed\": $3, \"spp\": $4, \"path\": \"$5\"}"); }
+stage=""
+add_run() {
+    runs+=("{\"renderer\": \"$1\", \"round\": $2, \"seed\": $3, \"spp\": $4, \"path\": \"$5\"${stage:+, \"stage\": \"$stage\"}}")
+}
+cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
+write_runs() {
+    {
+        printf '{"scene": "%s", "width": %d, "height": %d, "max_bounces": %d, "threads": %d,\n' \
+            "$scene" "$width" "$height" "$bounces" "$threads"
+        printf ' "machine": "%s, %d CPUs", "date": "%s", "seed_base": %d, "target": %s,\n' \
+            "$cpu" "$(nproc)" "$(date -u '+%Y-%m-%d %H:%M UTC')" "$seed_base" "$target"
+        printf ' "runs": [\n  %s\n ]}\n' "$(IFS=,; echo "${runs[*]}" | sed 's/},{/},\n  {/g')"
+    } >"$out/runs.json"
+}
+seed=$seed_base
+next_seed() { seed=$((seed + 1)); }
+
+if [[ -n $ladder ]]; then
+    # The ladder: both renderers' seed pairs at n, 2n, ... until each brackets the target
+    stage=ladder n=$ladder rung=0 g_n="" c_n=""
+    while [[ -z $g_n || -z $c_n ]]; do
+        rung=$((rung + 1))
+        [[ $n -le 1048576 ]] || die "the ladder passed 1048576 spp without reaching $target"
+        for s in 1 2; do
+            next_seed
+            if [[ -z $g_n ]]; then
+                gilab_render "$n" $seed "ladder_gilab_${n}_s$seed"
+                add_run gilab "$rung" $seed "$n" "ladder_gilab_${n}_s$seed"
+            fi
+            if [[ -z $c_n ]]; then
+                cycles_render "$n" $seed "ladder_cycles_${n}_s$seed"
+                add_run cycles "$rung" $seed "$n" "ladder_cycles_${n}_s$seed"
+            fi
+        done
+        write_runs
+        status=$($py "$root/scripts/cycles_crosscheck.py" --ladder-status "$out") || exit 1
+        echo "$status" | sed 's/^/ladder: /'
+        g_n=$(awk '$1 == "gilab" && $2 != "-" {print $2}' <<<"$status")
+        c_n=$(awk '$1 == "cycles" && $2 != "-" {print $2}' <<<"$status")
+        n=$((n * 2))
+    done
+    # Render at the count the ladder found, rounded up to whole batches of 16 (gilab's --batch)
+    gilab_spp=$($py -c "import math; print(16 * math.ceil($g_n / 16))")
+    cycles_spp=$($py -c "import math; print(16 * math.ceil($c_n / 16))")
+    echo "ladder: rendering gilab at $gilab_spp spp and Cycles at $cycles_spp spp"
+    stage=final
+fi
 for ((r = 1; r <= rounds; ++r)); do
-    s1=$((2 * r - 1)) s2=$((2 * r))
+    if [[ -n $ladder ]]; then
+        next_seed; s1=$seed; next_seed; s2=$seed
+    else
+        s1=$((2 * r - 1)) s2=$((2 * r))
+    fi
     gilab_render "$gilab_spp" $s1 "gilab_r${r}_s$s1"; add_run gilab $r $s1 "$gilab_spp" "gilab_r${r}_s$s1"
     cycles_render "$cycles_spp" $s1 "cycles_r${r}_s$s1"; add_run cycles $r $s1 "$cycles_spp" "cycles_r${r}_s$s1"
     gilab_render "$gilab_spp" $s2 "gilab_r${r}_s$s2"; add_run gilab $r $s2 "$gilab_spp" "gilab_r${r}_s$s2"
@@ -140,12 +210,6 @@ for ((r = 1; r <= rounds; ++r)); do
     gilab_render 1 1000 "gilab_r${r}_setup"; add_run gilab $r 1000 1 "gilab_r${r}_setup"
     cycles_render 1 1000 "cycles_r${r}_setup"; add_run cycles $r 1000 1 "cycles_r${r}_setup"
 done
-cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ *//')
-{
-    printf '{"scene": "%s", "width": %d, "height": %d, "max_bounces": %d, "threads": %d,\n' \
-        "$scene" "$width" "$height" "$bounces" "$threads"
-    printf ' "machine": "%s, %d CPUs", "date": "%s",\n' "$cpu" "$(nproc)" "$(date -u '+%Y-%m-%d %H:%M UTC')"
-    printf ' "runs": [\n  %s\n ]}\n' "$(IFS=,; echo "${runs[*]}" | sed 's/},{/},\n  {/g')"
-} >"$out/runs.json"
+write_runs
 
 $py "$root/scripts/cycles_crosscheck.py" "$out"
