@@ -162,19 +162,8 @@ def analyse_final(renders, target=TARGET):
                          "seconds_to_target": n_target * wall,
                          "cpu_seconds_to_target": n_target * cpu,
                          "extrapolated_spp": old_spp, "extrapolated_seconds": old_spp * wall})
-    ratios = []
-    for rnd in sorted({r["round"] for r in rows}):
-        g = next(r for r in rows if r["renderer"] == "gilab" and r["round"] == rnd)
-        c = next(r for r in rows if r["renderer"] == "cycles" and r["round"] == rnd)
-        ratios.append({"round": rnd,
-                       "wall": g["seconds_to_target"] / c["seconds_to_target"],
-                       "cpu": g["cpu_seconds_to_target"] / c["cpu_seconds_to_target"],
-                       "spp": g["spp_to_target"] / c["spp_to_target"],
-                       "s_per_spp": g["s_per_spp"] / c["s_per_spp"],
-                       "extrapolated_wall": g["extrapolated_seconds"] / c["extrapolated_seconds"]})
-    spread = {k: [min(q[k] for q in ratios), max(q[k] for q in ratios)]
-              for k in ("wall", "cpu", "spp", "s_per_spp", "extrapolated_wall")}
-    return rows, ratios, spread
+    return (rows, *round_ratios(rows, {"spp": "spp_to_target",
+                                       "extrapolated_wall": "extrapolated_seconds"}))
 
 
 def analyse(renders):
@@ -201,17 +190,21 @@ def analyse(renders):
                          "setup_seconds": setup[0]["seconds"],
                          "seconds_to_target": a / TARGET * float(wall),
                          "cpu_seconds_to_target": a / TARGET * float(cpu)})
+    return (rows, *round_ratios(rows, {"a": "a"}))
+
+
+def round_ratios(rows, extra):
+    """Per round, gilab / Cycles of the times to the target, the s/spp and the `extra` row
+    fields ({ratio name: row key}); over rounds, each ratio's [min, max]."""
+    keys = {"wall": "seconds_to_target", "cpu": "cpu_seconds_to_target", **extra,
+            "s_per_spp": "s_per_spp"}
     ratios = []
     for rnd in sorted({r["round"] for r in rows}):
         g = next(r for r in rows if r["renderer"] == "gilab" and r["round"] == rnd)
         c = next(r for r in rows if r["renderer"] == "cycles" and r["round"] == rnd)
-        ratios.append({"round": rnd,
-                       "wall": g["seconds_to_target"] / c["seconds_to_target"],
-                       "cpu": g["cpu_seconds_to_target"] / c["cpu_seconds_to_target"],
-                       "a": g["a"] / c["a"], "s_per_spp": g["s_per_spp"] / c["s_per_spp"]})
-    spread = {k: [min(r[k] for r in ratios), max(r[k] for r in ratios)]
-              for k in ("wall", "cpu", "a", "s_per_spp")}
-    return rows, ratios, spread
+        ratios.append({"round": rnd, **{name: g[k] / c[k] for name, k in keys.items()}})
+    spread = {name: [min(q[name] for q in ratios), max(q[name] for q in ratios)] for name in keys}
+    return ratios, spread
 
 
 def agreement(renders):
