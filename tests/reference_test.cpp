@@ -258,7 +258,7 @@ TEST(CpuReferenceFurnace, RussianRouletteIsUnbiased) {
 }
 
 TEST(CpuReferenceFurnace, DefaultRouletteIsUnbiasedOverManyBounces) {
-    // rho = 0.9: the throughput falls below the default threshold (0.05) after ~29 bounces, so
+    // rho = 0.9: the throughput falls below the default threshold (0.2) after ~16 bounces, so
     // the roulette thins the tail of 64 bounces; every layer must still match rho^k.
     const ReferenceSettings defaults;
     checkFurnace(0.9f, Estimator::Mis, 64, 1024, defaults.rouletteStartBounce);
