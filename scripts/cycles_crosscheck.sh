@@ -15,12 +15,16 @@
 # pooled images. Writes OUT/crosscheck.{json,md}; the figures belong in docs/reference.md
 # ("Measured: ground-truth speed").
 #
-# usage: scripts/cycles_crosscheck.sh [--scene cornell|sponza] [--rounds R] [--gilab-spp N]
+# usage: scripts/cycles_crosscheck.sh [--scene NAME] [--rounds R] [--gilab-spp N]
 #          [--cycles-spp N] [--threads T] [--out DIR] [--gilab-sampler independent|sobol]
-#          [--ladder N] [--seed-base S] [--target E]
+#          [--ladder N] [--seed-base S] [--target E] [--pixel-filter center|box]
 #   cornell (default): McGuire's Cornell box glTF, 256x256, 64 bounces, gilab 1024 / Cycles 512 spp
 #   sponza: Dabrovic Sponza, the sun of scenes/sponza.json, 256x144, 16 bounces, textured,
 #           gilab 256 / Cycles 128 spp
+#   sponza-flat: the same with every base-colour texture replaced by its mean linear colour
+#           (scripts/gltf_mean_factors.py), the integrators without texture filtering
+#   sponza-linear: textured, Cycles' textures decoded to linear floats before it filters them
+#           (as gilab does; Cycles decodes 8-bit sRGB after its bilinear filter)
 #   --rounds: repeats of the interleaved seed pairs (default 2; the ratio's spread needs >= 2)
 #   --ladder N: measure at relMSE 1e-3 instead of extrapolating to it (issue 49): seed pairs of
 #       both renderers at N, 2N, 4N, ... spp until each reaches 1e-3 (the count is interpolated
@@ -28,19 +32,22 @@
 #       pairs at that count; --gilab-spp and --cycles-spp are not used
 #   --seed-base S: first seed (default: from the clock, so every sitting draws new seeds)
 #   --target E: the relMSE the ladder measures at (default 1e-3; larger only for a quick try)
+#   --pixel-filter: center (default; gilab filters the camera hit's textures at the rasteriser's
+#       mip level) or box (both renderers average over the pixel, textures at full resolution)
 #   env GILAB: the gilab binary (default build/gilab)
 # tiny test: scripts/cycles_crosscheck.sh --rounds 2 --gilab-spp 8 --cycles-spp 8 --out /tmp/x
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
 scene=cornell rounds="" gilab_spp="" cycles_spp="" threads=2 sampler=independent ladder=""
+pixel_filter=center
 seed_base=$(( $(date +%s) % 1000000 * 100 )) target=1e-3
 out=""
 gilab=${GILAB:-$root/build/gilab}
 py=/usr/bin/python3
 
 die() { echo "cycles_crosscheck: $*" >&2; exit 1; }
-usage() { sed -n '18,33p' "$0"; exit "${1:-2}"; }
+usage() { sed -n '18,39p' "$0"; exit "${1:-2}"; }
 
 while [[ $# -gt 0 ]]; do
     [[ $1 == -h || $1 == --help ]] && usage 0
@@ -56,6 +63,7 @@ while [[ $# -gt 0 ]]; do
         --ladder) ladder=$2 ;;
         --seed-base) seed_base=$2 ;;
         --target) target=$2 ;;
+        --pixel-filter) pixel_filter=$2 ;;
         *) echo "unknown option $1" >&2; usage ;;
     esac
     shift 2
@@ -66,14 +74,18 @@ case $scene in
         gltf=$root/../shared/scenes/cornell-box/cornell_box.gltf
         width=256 height=256 bounces=64 textures=""
         : "${gilab_spp:=1024}" "${cycles_spp:=512}" ;;
-    sponza)
+    sponza | sponza-flat | sponza-linear)
         desc=$root/scenes/sponza.json
         gltf=$root/../shared/scenes/dabrovic-sponza/sponza.gltf
         width=256 height=144 bounces=16 textures=--textures
+        [[ $scene == sponza-flat ]] && textures=""
+        [[ $scene == sponza-linear ]] && textures="--textures --linear-textures"
         : "${gilab_spp:=256}" "${cycles_spp:=128}" ;;
-    *) die "--scene takes cornell or sponza (got $scene)" ;;
+    *) die "--scene takes cornell, sponza, sponza-flat or sponza-linear (got $scene)" ;;
 esac
 : "${out:=results/cycles_crosscheck/$scene}"
+[[ $pixel_filter == center || $pixel_filter == box ]] ||
+    die "--pixel-filter takes center or box (got $pixel_filter)"
 [[ $sampler == independent || $sampler == sobol ]] ||
     die "--gilab-sampler takes independent or sobol"
 if [[ -n $ladder ]]; then
@@ -114,6 +126,12 @@ fi
 
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
+if [[ $scene == sponza-flat ]]; then
+    # Both renderers see the textures replaced by their mean linear colours (issue 49)
+    $py "$root/scripts/gltf_mean_factors.py" "$gltf" "$out/sponza_mean_factors.gltf" ||
+        die "scripts/gltf_mean_factors.py failed"
+    gltf=$out/sponza_mean_factors.gltf
+fi
 # One scene description for both renderers: the preset's camera and lights, this glTF.
 $py - "$desc" "$(realpath "$gltf")" "$width" "$height" "$out/scene.json" <<'PY'
 import json, sys
@@ -132,7 +150,7 @@ if [[ $threads -lt $(nproc) ]]; then pin=(taskset -c "0-$((threads - 1))"); fi
 gilab_render() {  # spp seed dir
     echo "gilab:  $1 spp (seed $2, $sampler sampler) -> $3"
     "${pin[@]}" "$gilab" reference --scene "$out/scene.json" --resolution "${width}x${height}" \
-        --max-bounces "$bounces" --pixel-filter center --spp "$1" --seed "$2" \
+        --max-bounces "$bounces" --pixel-filter "$pixel_filter" --spp "$1" --seed "$2" \
         --sampler "$sampler" --batch 16 --no-cache -o "$out/$3" -q >/dev/null ||
         die "gilab reference failed ($out/$3)"
 }
@@ -142,6 +160,7 @@ cycles_render() {  # spp seed name
     blender -b --factory-startup -t "$threads" --python "$root/scripts/cycles_render.py" -- \
         --scene "$out/scene.json" --out "$out/$3.exr" --width "$width" --height "$height" \
         --samples "$1" --seed "$2" --threads "$threads" --max-bounces "$bounces" \
+        --pixel-filter "$pixel_filter" \
         $textures >"$out/$3.log" 2>&1 ||
         { tail -n 20 "$out/$3.log" >&2; die "blender failed (log: $out/$3.log)"; }
     grep -q '^cycles_render: .* spp in' "$out/$3.log" ||

@@ -13,7 +13,7 @@
 #
 #   blender -b --factory-startup -t T --python scripts/cycles_render.py -- \
 #       --scene DIR/scene.json --out DIR/cycles_16.exr --width 256 --height 256 --samples 16 \
-#       --seed 1 --threads T [--textures]
+#       --seed 1 --threads T [--textures [--linear-textures]]
 import argparse
 import json
 import math
@@ -33,6 +33,12 @@ ap.add_argument("--width", type=int, default=256)
 ap.add_argument("--height", type=int, default=256)
 ap.add_argument("--textures", action="store_true",
                 help="keep the importer's base-colour textures (else the factors only)")
+ap.add_argument("--linear-textures", action="store_true",
+                help="with --textures: decode every sRGB texel to linear float before Cycles "
+                     "filters it (as gilab does), instead of Cycles' filter-then-decode")
+ap.add_argument("--pixel-filter", choices=("center", "box"), default="center",
+                help="center: rays through pixel centres (gilab's --pixel-filter center); box: "
+                     "uniform over the pixel (gilab's box)")
 ap.add_argument("--samples", type=int, default=16)
 ap.add_argument("--seed", type=int, default=1)
 ap.add_argument("--threads", type=int, default=2)
@@ -143,6 +149,40 @@ for obj in scene.objects:
             replaced[name] = diffuse_emission_material(name, by_name.get(name, {}), slot.material)
         slot.material = replaced[name]
 
+
+
+def linearised(image):
+    """A float copy of an 8-bit sRGB image with every texel decoded (IEC 61966-2-1) before any
+    filtering: Cycles keeps 8-bit sRGB images as bytes and decodes after its bilinear filter
+    (svm_image_texture's NODE_IMAGE_COMPRESS_AS_SRGB), gilab decodes each texel first."""
+    w, h = image.size
+    px = numpy.empty(w * h * 4, dtype=numpy.float32)
+    image.pixels.foreach_get(px)  # the stored values, sRGB-encoded, in [0, 1]
+    rgb = px.reshape(-1, 4)[:, :3].astype(numpy.float64)
+    px.reshape(-1, 4)[:, :3] = numpy.where(rgb <= 0.04045, rgb / 12.92,
+                                           ((rgb + 0.055) / 1.055) ** 2.4)
+    out = bpy.data.images.new(image.name + ".linear", w, h, alpha=True, float_buffer=True)
+    out.colorspace_settings.name = "Linear"
+    out.pixels.foreach_set(px)
+    out.pack()
+    return out
+
+
+if args.linear_textures:
+    if not args.textures:
+        sys.exit("cycles_render: --linear-textures needs --textures")
+    copies = {}
+    for mat in replaced.values():
+        for node in (mat.node_tree.nodes if mat and mat.use_nodes else []):
+            if node.type == "TEX_IMAGE" and node.image is not None:
+                if node.image.colorspace_settings.name != "sRGB":
+                    sys.exit(f"cycles_render: image {node.image.name} is "
+                             f"{node.image.colorspace_settings.name}, not sRGB")
+                if node.image.name not in copies:
+                    copies[node.image.name] = linearised(node.image)
+                node.image = copies[node.image.name]
+    print(f"cycles_render: {len(copies)} textures decoded to linear float before filtering")
+
 # Camera: glTF Y-up -> Blender Z-up as the importer does it, (x, y, z) -> (x, -z, y).
 cam_desc = desc["camera"]
 
@@ -220,10 +260,15 @@ c.min_light_bounces = args.min_light_bounces
 if hasattr(c, "light_sampling_threshold"):
     c.light_sampling_threshold = 0.0
 # Rays (almost) through pixel centres, like gilab's --pixel-filter center. Not "BOX": Blender
-# hands Cycles a box filter always 1 pixel wide, whatever filter_width says. A Gaussian of the
-# minimum width 0.01 keeps every ray within 0.015 pixel of the centre.
-c.pixel_filter_type = "GAUSSIAN"
-c.filter_width = 0.01
+# hands Cycles a box filter always 1 pixel wide, whatever filter_width says (which is exactly
+# gilab's --pixel-filter box). A Gaussian of the minimum width 0.01 keeps every ray within
+# 0.015 pixel of the centre.
+if args.pixel_filter == "box":
+    c.pixel_filter_type = "BOX"
+    c.filter_width = 1.0
+else:
+    c.pixel_filter_type = "GAUSSIAN"
+    c.filter_width = 0.01
 c.film_exposure = 1.0
 scene.view_settings.view_transform = "Standard"
 scene.view_settings.look = "None"
@@ -248,8 +293,10 @@ info = {
     "seconds": seconds,
     "cpu_seconds": cpu_seconds,
     "seconds_per_sample": seconds / args.samples,
-    "settings": {"device": "CPU", "max_bounces": args.max_bounces, "pixel_filter": "gaussian 0.01",
+    "settings": {"device": "CPU", "max_bounces": args.max_bounces, "pixel_filter":
+                 "box 1 px" if args.pixel_filter == "box" else "gaussian 0.01",
                  "adaptive": False, "denoise": False, "clamp": 0, "textures": args.textures,
+                 "linear_textures": args.linear_textures,
                  "min_light_bounces": c.min_light_bounces,
                  "sampling_pattern": c.sampling_pattern},
 }
