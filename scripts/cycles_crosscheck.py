@@ -246,7 +246,8 @@ def agreement(renders):
 
 def markdown(meta, rows, ratios, spread, agree):
     lines = [f"# Cycles cross-check: {meta['scene']} ({meta['width']}x{meta['height']}, "
-             f"{meta['max_bounces']} bounces, {meta['threads']} threads)", "",
+             f"{meta['max_bounces']} bounces, {meta['threads']} threads, "
+             f"pixel filter {meta.get('pixel_filter', 'center')})", "",
              f"gilab reference path tracer v{meta['gilab_version']} ({meta['gilab_sampler']} "
              f"sampler) vs Blender {meta['blender_version']} Cycles (CPU, its defaults). "
              f"{len(ratios)} rounds, each: gilab seed 1, Cycles seed 1, gilab seed 2, Cycles seed "
@@ -289,7 +290,8 @@ def markdown_final(meta, ladders, rows, ratios, spread, agree, target=TARGET):
     """crosscheck.md of a ladder run (--ladder): the rungs, the rounds at the target, the ratios
     with the old extrapolation beside them, and the agreement."""
     lines = [f"# Cycles cross-check at relMSE {target:g}: {meta['scene']} ({meta['width']}x"
-             f"{meta['height']}, {meta['max_bounces']} bounces, {meta['threads']} threads)", "",
+             f"{meta['height']}, {meta['max_bounces']} bounces, {meta['threads']} threads, "
+             f"pixel filter {meta.get('pixel_filter', 'center')})", "",
              f"gilab reference path tracer v{meta['gilab_version']} ({meta['gilab_sampler']} "
              f"sampler) vs Blender {meta['blender_version']} Cycles (CPU, its defaults). "
              f"Machine: {meta['machine']}; {meta['date']}; seeds from {meta.get('seed_base', 1)}.",

@@ -178,6 +178,7 @@ write_runs() {
     {
         printf '{"scene": "%s", "width": %d, "height": %d, "max_bounces": %d, "threads": %d,\n' \
             "$scene" "$width" "$height" "$bounces" "$threads"
+        printf ' "pixel_filter": "%s",\n' "$pixel_filter"
         printf ' "machine": "%s, %d CPUs", "date": "%s", "seed_base": %d, "target": %s,\n' \
             "$cpu" "$(nproc)" "$(date -u '+%Y-%m-%d %H:%M UTC')" "$seed_base" "$target"
         printf ' "runs": [\n  %s\n ]}\n' "$(IFS=,; echo "${runs[*]}" | sed 's/},{/},\n  {/g')"

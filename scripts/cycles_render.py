@@ -150,7 +150,6 @@ for obj in scene.objects:
         slot.material = replaced[name]
 
 
-
 def linearised(image):
     """A float copy of an 8-bit sRGB image with every texel decoded (IEC 61966-2-1) before any
     filtering: Cycles keeps 8-bit sRGB images as bytes and decodes after its bilinear filter
@@ -159,8 +158,7 @@ def linearised(image):
     px = numpy.empty(w * h * 4, dtype=numpy.float32)
     image.pixels.foreach_get(px)  # the stored values, sRGB-encoded, in [0, 1]
     rgb = px.reshape(-1, 4)[:, :3].astype(numpy.float64)
-    px.reshape(-1, 4)[:, :3] = numpy.where(rgb <= 0.04045, rgb / 12.92,
-                                           ((rgb + 0.055) / 1.055) ** 2.4)
+    px.reshape(-1, 4)[:, :3] = srgb_to_linear(rgb)
     out = bpy.data.images.new(image.name + ".linear", w, h, alpha=True, float_buffer=True)
     out.colorspace_settings.name = "Linear"
     out.pixels.foreach_set(px)
@@ -169,6 +167,8 @@ def linearised(image):
 
 
 if args.linear_textures:
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    from gltf_mean_factors import srgb_to_linear  # noqa: E402 (one sRGB decode for both)
     if not args.textures:
         sys.exit("cycles_render: --linear-textures needs --textures")
     copies = {}
