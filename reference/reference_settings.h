@@ -55,8 +55,10 @@ struct ReferenceSettings {
     Estimator estimator = Estimator::Mis;
     uint64_t seed = 1;
     PixelFilter pixelFilter = PixelFilter::Center;
-    /** Independent uniforms (default) or Owen-scrambled Sobol (docs/reference.md, "Samplers"). */
-    SamplerKind sampler = SamplerKind::Independent;
+    /** Owen-scrambled Sobol in replicates (default since 2026-12-05, issue 49: 1.38-1.46x the
+     *  efficiency on textured scenes, 1.03x on the Cornell box) or independent uniforms
+     *  (exact per-pixel error bars at any count) (docs/reference.md, "Samplers"). */
+    SamplerKind sampler = SamplerKind::Sobol;
     /** Sobol only: samples per independently scrambled replicate (a power of two); the spread of
      *  the replicates gives the per-pixel error bars (docs/reference.md, "Samplers"). */
     uint32_t sobolReplicate = 64;

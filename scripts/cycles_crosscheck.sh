@@ -16,7 +16,7 @@
 # ("Measured: ground-truth speed").
 #
 # usage: scripts/cycles_crosscheck.sh [--scene NAME] [--rounds R] [--gilab-spp N]
-#          [--cycles-spp N] [--threads T] [--out DIR] [--gilab-sampler independent|sobol]
+#          [--cycles-spp N] [--threads T] [--out DIR] [--gilab-sampler sobol|independent]
 #          [--ladder N] [--seed-base S] [--target E] [--pixel-filter center|box]
 #   cornell (default): McGuire's Cornell box glTF, 256x256, 64 bounces, gilab 1024 / Cycles 512 spp
 #   sponza: Dabrovic Sponza, the sun of scenes/sponza.json, 256x144, 16 bounces, textured,
@@ -39,7 +39,7 @@
 set -euo pipefail
 
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)
-scene=cornell rounds="" gilab_spp="" cycles_spp="" threads=2 sampler=independent ladder=""
+scene=cornell rounds="" gilab_spp="" cycles_spp="" threads=2 sampler=sobol ladder=""
 pixel_filter=center
 seed_base=$(( $(date +%s) % 1000000 * 100 )) target=1e-3
 out=""
