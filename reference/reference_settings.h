@@ -56,7 +56,7 @@ struct ReferenceSettings {
     uint64_t seed = 1;
     PixelFilter pixelFilter = PixelFilter::Center;
     /** Owen-scrambled Sobol in replicates (default since 2026-12-05, issue 49: 1.38-1.46x the
-     *  efficiency on textured scenes, 1.03x on the Cornell box) or independent uniforms
+     *  efficiency on textured scenes, 1.00-1.03x on the Cornell box) or independent uniforms
      *  (exact per-pixel error bars at any count) (docs/reference.md, "Samplers"). */
     SamplerKind sampler = SamplerKind::Sobol;
     /** Sobol only: samples per independently scrambled replicate (a power of two); the spread of

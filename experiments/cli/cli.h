@@ -139,7 +139,7 @@ struct ReferenceOptions {
     float rouletteThreshold = ref::ReferenceSettings{}.rouletteThreshold;
     std::string estimator = "mis";        // mis | nee | bsdf
     std::string pixelFilter = "center";   // "center" (the rasteriser's footprint) | "box"
-    std::string sampler = ref::samplerKindName(ref::ReferenceSettings{}.sampler);  // | "independent"
+    std::string sampler = ref::samplerKindName(ref::ReferenceSettings{}.sampler);  // or "independent"
     uint32_t sobolReplicate = ref::ReferenceSettings{}.sobolReplicate;
     uint64_t seed = 1;
     uint32_t batchSamples = ref::ReferenceSettings{}.batchSamples;
@@ -168,7 +168,7 @@ struct BenchReferenceOptions {
     int rouletteDepth = ref::ReferenceSettings{}.rouletteStartBounce;
     float rouletteThreshold = ref::ReferenceSettings{}.rouletteThreshold;
     std::string pixelFilter = "box";      // "box" | "center"
-    std::string sampler = ref::samplerKindName(ref::ReferenceSettings{}.sampler);  // | "independent"
+    std::string sampler = ref::samplerKindName(ref::ReferenceSettings{}.sampler);  // or "independent"
     std::string outDir;                   // "" = print only
     bool quiet = false;
     std::string commandLine;
